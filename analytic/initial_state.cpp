@@ -1,0 +1,35 @@
+// The scene's initial state, shared by the reference and every engine so that all start alike.
+#include "initial_state.h"
+
+namespace tippe {
+
+BodyState scene_initial_state(const Scene& scene) {
+  const BodyModel m = BodyModel::from_scene(scene);
+  BodyState x;
+  x.t = 0.0;
+  x.q_WB = Quat(Eigen::AngleAxisd(scene.initial.tilt, Vec3::UnitX()));
+  const Vec3 R_C_W = contact_offset_W(m, x.q_WB, Surface::Ball);
+  const Vec3 R_C_B = x.q_WB.conjugate() * R_C_W;
+  if (scene.initial.omega_along_contact) {
+    // R_C points down the axis (R_C . e_Z = d - R cos(tilt) < 0 for a top with d < R), so
+    // -spin R_C/|R_C| spins counter-clockwise about e_Z for positive spin.
+    x.w_B = -scene.initial.spin * R_C_B.normalized();
+  } else if (scene.initial.omega_given) {
+    x.w_B = Vec3(scene.initial.omega_B[0], scene.initial.omega_B[1], scene.initial.omega_B[2]);
+  } else {
+    x.w_B = Vec3(0, 0, scene.initial.spin);
+  }
+  const Vec3 w_W = x.q_WB * x.w_B;
+  x.p_WG = Vec3(0, 0, -R_C_W.z());
+  if (scene.contact.friction == FrictionLaw::Rolling) {
+    x.v_WG = R_C_W.cross(w_W);
+  } else {
+    x.v_WG = Vec3(scene.initial.velocity[0], scene.initial.velocity[1], 0.0);
+  }
+  // v_Oz = 0: the ball centre moves horizontally while the ball touches the floor.
+  const Vec3 e_Z = x.q_WB * Vec3::UnitZ();
+  x.v_WG.z() = -(w_W.cross(m.d * e_Z)).z();
+  return x;
+}
+
+}  // namespace tippe

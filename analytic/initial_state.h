@@ -1,0 +1,16 @@
+// The scene's initial state, shared by the reference and every engine so that all start alike.
+#pragma once
+
+#include "observables.h"
+#include "scene.h"
+#include "state.h"
+
+namespace tippe {
+
+// Body tilted by initial.tilt about the lab x axis, resting on its ball (G above the origin at
+// the height that puts the ball on the floor), angular velocity from spin, omega_B or
+// omega_along_contact, horizontal velocity of G as given (rolling: R_C x omega), vertical
+// velocity of G such that the ball's lowest point does not move vertically.
+BodyState scene_initial_state(const Scene& scene);
+
+}  // namespace tippe

@@ -1,0 +1,83 @@
+// Plain description of one tippe-top scene: body, contact law, start and run settings (no file I/O).
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace tippe {
+
+enum class FrictionLaw { Rolling, Viscous, Coulomb, None };
+enum class MassModel { Seed, Solid, Given };
+
+const char* to_string(FrictionLaw law);
+const char* to_string(MassModel model);
+
+// Geometry of the sphere+stem body. l is measured from the ball centre O to the centre P of the
+// stem's tip hemisphere; h is the height above O where the ball is cut.
+struct BodyGeometry {
+  double sphere_radius = 0.0;      // R
+  double stem_radius = 0.0;        // r
+  double stem_length = 0.0;        // l
+  double truncation_height = 0.0;  // h
+  double density = 0.0;
+  MassModel mass_model = MassModel::Solid;
+};
+
+// Mass properties about the centre of mass G; G sits a distance com_offset (d) below the ball
+// centre O along the symmetry axis, i.e. O = G + d e_Z.
+struct MassProperties {
+  double mass = 0.0;                // M
+  double com_offset = 0.0;          // d
+  double inertia_transverse = 0.0;  // A = B
+  double inertia_axial = 0.0;       // C
+};
+
+struct ContactSpec {
+  FrictionLaw friction = FrictionLaw::Coulomb;
+  double mu = 0.0;        // Coulomb coefficient
+  double k = 0.0;         // viscous coefficient, F_t = -k v_C
+  double drilling = 0.0;  // torsional friction length mu_d: |tau| <= mu_d F_n
+  bool stem = true;       // false: a bare eccentric ball
+  bool flight = false;    // true: free flight after loss of contact instead of ending the run
+};
+
+struct InitialSpec {
+  double tilt = 0.0;                       // rad, rotation of the body about the lab x axis
+  bool omega_given = false;                // omega_B given instead of spin
+  double spin = 0.0;                       // rad/s about the symmetry axis e_Z
+  std::array<double, 3> omega_B{0, 0, 0};  // body-frame angular velocity when omega_given
+  bool velocity_given = false;
+  std::array<double, 2> velocity{0, 0};    // horizontal velocity of G
+  bool omega_along_contact = false;        // omega parallel to R_C so that v_C = v_G
+};
+
+struct RunSpec {
+  double duration = 1.0;
+  double sample_interval = 1e-3;
+  double rtol = 1e-10;
+  double atol = 1e-12;
+};
+
+// One value of an engine setting as written in a scene or on the command line.
+using SettingValue = std::variant<bool, long long, double, std::string, std::vector<double>>;
+// engine name -> key -> value, e.g. settings["mujoco"]["timestep"] = 1e-4.
+using EngineSettingTable = std::map<std::string, std::map<std::string, SettingValue>>;
+
+struct Scene {
+  std::string name;
+  std::string description;
+  std::string source_file;   // where it was read from (for messages and provenance)
+  std::string content_hash;  // hash of the file's bytes and overrides, for caches and provenance
+  double gravity = 9.81;
+  BodyGeometry body;
+  MassProperties mass;  // always filled: computed from body, or given directly
+  ContactSpec contact;
+  InitialSpec initial;
+  RunSpec run;
+  EngineSettingTable engines;
+};
+
+}  // namespace tippe

@@ -1,0 +1,133 @@
+// Shared stepping loop of the fixed-step engines: events, failure classification, viscous law, work.
+#include "fixed_step.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "timing.h"
+
+namespace tippe {
+
+const char* to_string(RunStatus s) {
+  switch (s) {
+    case RunStatus::Ok: return "ok";
+    case RunStatus::ContactLost: return "contact_lost";
+    case RunStatus::Diverged: return "diverged";
+    case RunStatus::Unphysical: return "unphysical";
+    case RunStatus::Clamped: return "clamped";
+    case RunStatus::Failed: return "failed";
+  }
+  return "?";
+}
+
+FixedStepSimulator::FixedStepSimulator(const Scene& scene)
+    : scene_(scene), body_(BodyModel::from_scene(scene)) {}
+
+void FixedStepSimulator::start(double dt) {
+  dt_ = dt;
+  const BodyState x0 = engine_state();
+  last_ = observe_kinematics(body_, x0);
+  e0_ = last_.energy;
+  speed_scale_ = std::max({x0.w_B.norm(), x0.v_WG.norm() / body_.R, std::sqrt(body_.g / body_.R), 1e-12});
+  contact_surface_ = Surface::Ball;
+}
+
+Observation FixedStepSimulator::observe() const {
+  Observation o = observe_kinematics(body_, engine_state());
+  const ContactReport c = engine_contacts();
+  o.normal_force = c.normal_force;
+  o.engine_contact_valid = c.point_valid;
+  o.p_WC_engine = c.p_WC;
+  return o;
+}
+
+void FixedStepSimulator::fail(RunStatus s, double t, const std::string& why) {
+  status_ = s;
+  status_time_ = t;
+  status_detail_ = why;
+  events_.push_back({to_string(s), t, why, 0.0});
+}
+
+void FixedStepSimulator::advance_to(double t) {
+  WorkTimer timer(work_.wall_seconds, work_.cpu_seconds);
+  // Steps whose end lies within half a step of t count as reaching t.
+  while (status_ == RunStatus::Ok && (static_cast<double>(n_steps_) + 0.5) * dt_ <= t) step_once();
+}
+
+void FixedStepSimulator::step_once() {
+  const BodyState x = engine_state();
+  if (scene_.contact.friction == FrictionLaw::Viscous) {
+    // The source's law F_t = -k v_C at the geometric contact point, while the engine has a
+    // contact: the engine's own contact is frictionless in this mode.
+    const ContactReport c = engine_contacts();
+    if (c.ball || c.stem) {
+      const Surface s = lower_surface(body_, x.q_WB);
+      const Vec3 R_C = contact_offset_W(body_, x.q_WB, s);
+      const Vec3 w_W = x.q_WB * x.w_B;
+      Vec3 v_C = x.v_WG + w_W.cross(R_C);
+      v_C.z() = 0.0;
+      apply_force_W(-scene_.contact.k * v_C, x.p_WG + R_C);
+    }
+  }
+  engine_step();
+  ++n_steps_;
+  work_.steps = n_steps_;
+  work_.rhs_evaluations = n_steps_;
+  work_.solver_iterations = engine_solver_iterations();
+  const double t = static_cast<double>(n_steps_) * dt_;
+  const Observation now = observe_kinematics(body_, engine_state());
+  const BodyState& y = now.state;
+  const bool finite = y.p_WG.allFinite() && y.v_WG.allFinite() && y.q_WB.coeffs().allFinite() &&
+                      y.w_B.allFinite();
+  if (!finite) return fail(RunStatus::Diverged, t, "non-finite state");
+  track_events(last_, now);
+  last_ = now;
+  const double gap = std::min(surface_gap(body_, y, Surface::Ball),
+                              body_.stem ? surface_gap(body_, y, Surface::Stem) : 1e300);
+  std::ostringstream why;
+  why.precision(6);
+  if (gap < -limits_.penetration_fraction * body_.R) {
+    why << "fell through the floor: lowest point at " << gap << " (limit " << -limits_.penetration_fraction * body_.R << ")";
+    return fail(RunStatus::Diverged, t, why.str());
+  }
+  if (e0_ > 0 && now.energy > limits_.energy_factor * e0_) {
+    why << "energy " << now.energy << " above " << limits_.energy_factor << " E0 = " << limits_.energy_factor * e0_;
+    return fail(RunStatus::Diverged, t, why.str());
+  }
+  const double speed = std::max(y.w_B.norm(), y.v_WG.norm() / body_.R);
+  if (speed > limits_.speed_factor * speed_scale_) {
+    why << "speed blow-up: " << speed << " rad/s equivalent";
+    return fail(RunStatus::Diverged, t, why.str());
+  }
+  const std::string limit = engine_limit_hit();
+  if (!limit.empty()) return fail(RunStatus::Clamped, t, limit);
+}
+
+void FixedStepSimulator::track_events(const Observation& a, const Observation& b) {
+  const double ta = a.state.t, tb = b.state.t;
+  // The engine's dense output is piecewise linear between steps: events are located by
+  // linear interpolation of the event function between the two step ends.
+  auto cross = [&](double fa, double fb) { return ta + (tb - ta) * fa / (fa - fb); };
+  const double ca = std::cos(a.theta), cb = std::cos(b.theta);
+  if (!inverted_ && ca > 0 && cb <= 0) {
+    inverted_ = true;
+    events_.push_back({"inversion", cross(ca, cb), "theta crosses 90 deg", 0.0});
+  }
+  const ContactReport c = engine_contacts();
+  if (body_.stem && !stem_touched_ && c.stem) {
+    stem_touched_ = true;
+    const double ga = surface_gap(body_, a.state, Surface::Stem), gb = surface_gap(body_, b.state, Surface::Stem);
+    const double te = (ga > 0 && gb <= 0) ? cross(ga, gb) : tb;
+    events_.push_back({"stem_contact", te, "first stem contact reported by the engine", 0.0});
+  }
+  Surface s = Surface::None;
+  if (c.ball && c.stem) s = Surface::Both;
+  else if (c.ball) s = Surface::Ball;
+  else if (c.stem) s = Surface::Stem;
+  if (s != contact_surface_) {
+    events_.push_back({"switch", tb, std::string(to_string(contact_surface_)) + " -> " + to_string(s), 0.0});
+    contact_surface_ = s;
+  }
+}
+
+}  // namespace tippe

@@ -1,0 +1,77 @@
+// Shared stepping loop of the fixed-step engines: events, failure classification, viscous law, work.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "../analytic/initial_state.h"
+#include "simulator.h"
+
+namespace tippe {
+
+// What an engine says about its contacts after a step.
+struct ContactReport {
+  bool ball = false;               // the engine has a contact on the ball geom
+  bool stem = false;               // ... on the stem geom
+  double normal_force = 0.0;       // sum of normal forces on the body (N or scene units)
+  bool point_valid = false;
+  Vec3 p_WC = Vec3::Zero();        // engine's contact point (force-weighted mean when several)
+};
+
+// Limits that turn a run into a result instead of a crash (issue: failures are results).
+struct FailureLimits {
+  double energy_factor = 2.0;      // E above energy_factor * E0 (E0 > 0) -> diverged
+  double penetration_fraction = 0.1;  // lowest surface below the floor by more than R/10 -> diverged
+  double speed_factor = 100.0;     // |w| or |v_G| beyond factor * initial scale -> diverged
+};
+
+class FixedStepSimulator : public Simulator {
+ public:
+  void advance_to(double t) override;
+  Observation observe() const override;
+  WorkCounters work() const override { return work_; }
+  RunStatus status() const override { return status_; }
+  double status_time() const override { return status_time_; }
+  std::string status_detail() const override { return status_detail_; }
+  std::vector<Event> events() const override { return events_; }
+
+ protected:
+  explicit FixedStepSimulator(const Scene& scene);
+  // Must be called by the derived constructor once the engine is built.
+  void start(double dt);
+
+  virtual void engine_step() = 0;                  // advance the engine by dt
+  virtual BodyState engine_state() const = 0;      // state at the engine's current time
+  virtual ContactReport engine_contacts() const = 0;
+  // Adds a lab-frame force at a lab-frame point for the next step only.
+  virtual void apply_force_W(const Vec3& f_W, const Vec3& p_W) = 0;
+  // Non-empty when the last step hit an engine limit (e.g. Bullet's angular velocity clamp).
+  virtual std::string engine_limit_hit() const { return {}; }
+  virtual long long engine_solver_iterations() const { return 0; }
+
+  const Scene& scene() const { return scene_; }
+  const BodyModel& body() const { return body_; }
+  double dt() const { return dt_; }
+
+ private:
+  void step_once();
+  void track_events(const Observation& before, const Observation& after);
+  void fail(RunStatus s, double t, const std::string& why);
+
+  Scene scene_;
+  BodyModel body_;
+  FailureLimits limits_;
+  double dt_ = 0.0;
+  long long n_steps_ = 0;
+  double e0_ = 0.0, speed_scale_ = 0.0;
+  RunStatus status_ = RunStatus::Ok;
+  double status_time_ = 0.0;
+  std::string status_detail_;
+  std::vector<Event> events_;
+  WorkCounters work_;
+  Observation last_;
+  bool inverted_ = false, stem_touched_ = false;
+  Surface contact_surface_ = Surface::None;
+};
+
+}  // namespace tippe

@@ -1,0 +1,143 @@
+// Reading engine settings from a scene's [engines.NAME] table into plain structs, and listing them.
+#pragma once
+
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "../analytic/scene.h"
+#include "simulator.h"
+
+namespace tippe {
+
+// Applies the entries of one [engines.NAME] table to a settings struct. The struct exposes
+//   template <class V> void visit(V& v) { v("timestep", timestep); ... }
+// Unknown keys, wrong types and values outside a field's range raise std::invalid_argument
+// with the key named.
+class SettingsReader {
+ public:
+  SettingsReader(std::string engine, const std::map<std::string, SettingValue>& table)
+      : engine_(std::move(engine)), table_(table) {}
+
+  void operator()(const char* key, double& field, double lo, double hi) {
+    auto it = find(key);
+    if (!it) return;
+    double v;
+    if (auto p = std::get_if<double>(it)) v = *p;
+    else if (auto q = std::get_if<long long>(it)) v = static_cast<double>(*q);
+    else fail(key, "expected a number");
+    if (!(v >= lo && v <= hi)) fail(key, "value " + fmt(v) + " outside [" + fmt(lo) + ", " + fmt(hi) + "]");
+    field = v;
+  }
+  void operator()(const char* key, int& field, int lo, int hi) {
+    auto it = find(key);
+    if (!it) return;
+    auto q = std::get_if<long long>(it);
+    if (!q) fail(key, "expected an integer");
+    if (*q < lo || *q > hi) fail(key, "value " + std::to_string(*q) + " outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    field = static_cast<int>(*q);
+  }
+  void operator()(const char* key, bool& field) {
+    auto it = find(key);
+    if (!it) return;
+    auto b = std::get_if<bool>(it);
+    if (!b) fail(key, "expected true or false");
+    field = *b;
+  }
+  void operator()(const char* key, std::string& field, const std::vector<std::string>& choices) {
+    auto it = find(key);
+    if (!it) return;
+    auto s = std::get_if<std::string>(it);
+    if (!s) fail(key, "expected a string");
+    bool ok = false;
+    std::string list;
+    for (const auto& c : choices) {
+      ok = ok || c == *s;
+      list += (list.empty() ? "" : ", ") + c;
+    }
+    if (!ok) fail(key, "value \"" + *s + "\" is not one of: " + list);
+    field = *s;
+  }
+  void operator()(const char* key, std::vector<double>& field, size_t n) {
+    auto it = find(key);
+    if (!it) return;
+    auto a = std::get_if<std::vector<double>>(it);
+    if (!a || a->size() != n) fail(key, "expected an array of " + std::to_string(n) + " numbers");
+    for (double x : *a)
+      if (!std::isfinite(x)) fail(key, "non-finite number");
+    field = *a;
+  }
+  // Call after visiting: every key in the table must have been used.
+  void finish() const {
+    for (const auto& kv : table_)
+      if (!used_.count(kv.first))
+        throw std::invalid_argument("engines." + engine_ + "." + kv.first + ": unknown setting");
+  }
+
+ private:
+  const SettingValue* find(const char* key) {
+    auto it = table_.find(key);
+    if (it == table_.end()) return nullptr;
+    used_.insert(key);
+    return &it->second;
+  }
+  [[noreturn]] void fail(const char* key, const std::string& why) const {
+    throw std::invalid_argument("engines." + engine_ + "." + key + ": " + why);
+  }
+  static std::string fmt(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  }
+  std::string engine_;
+  const std::map<std::string, SettingValue>& table_;
+  std::set<std::string> used_;
+};
+
+// Lists a settings struct as key=value strings (round-trip precision for numbers).
+class SettingsLister {
+ public:
+  void operator()(const char* key, double& field, double, double) { put(key, num(field)); }
+  void operator()(const char* key, int& field, int, int) { put(key, std::to_string(field)); }
+  void operator()(const char* key, bool& field) { put(key, field ? "true" : "false"); }
+  void operator()(const char* key, std::string& field, const std::vector<std::string>&) { put(key, field); }
+  void operator()(const char* key, std::vector<double>& field, size_t) {
+    std::string s = "[";
+    for (size_t i = 0; i < field.size(); ++i) s += (i ? ", " : "") + num(field[i]);
+    put(key, s + "]");
+  }
+  SettingsList list;
+
+ private:
+  void put(const char* key, std::string v) { list.emplace_back(key, std::move(v)); }
+  static std::string num(double v) {
+    std::ostringstream os;
+    os.precision(17);
+    os << v;
+    return os.str();
+  }
+};
+
+template <class Settings>
+Settings read_settings(const std::string& engine, const Scene& scene) {
+  Settings s;
+  auto it = scene.engines.find(engine);
+  if (it == scene.engines.end()) return s;
+  SettingsReader r(engine, it->second);
+  s.visit(r);
+  r.finish();
+  return s;
+}
+
+template <class Settings>
+SettingsList list_settings(Settings s) {
+  SettingsLister l;
+  s.visit(l);
+  return l.list;
+}
+
+}  // namespace tippe

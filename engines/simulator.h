@@ -1,0 +1,65 @@
+// The one interface every simulator (the analytic reference and each engine) implements.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "../analytic/observables.h"
+#include "../analytic/scene.h"
+#include "../analytic/state.h"
+
+namespace tippe {
+
+// How a run ended (or is going). Anything but Ok ends the run at status_time.
+enum class RunStatus { Ok, ContactLost, Diverged, Unphysical, Clamped, Failed };
+const char* to_string(RunStatus s);
+
+// An event located in time: "inversion" (theta crosses 90 deg), "stem_contact" (first stem
+// touchdown), "switch" (contact surface changes), "stick", "slip", "contact_lost",
+// "touchdown", "two_contact" ...
+struct Event {
+  std::string name;
+  double time = 0.0;
+  std::string detail;
+  double value = 0.0;  // event-specific number (e.g. energy removed by an impact)
+};
+
+struct WorkCounters {
+  long long steps = 0;            // accepted integrator or engine steps
+  long long rhs_evaluations = 0;  // analytic: right-hand-side calls; engines: steps
+  long long solver_iterations = 0;
+  double wall_seconds = 0.0;      // of advance_to calls only
+  double cpu_seconds = 0.0;       // CPU time of the calling thread in advance_to
+};
+
+// Ordered key=value pairs of every setting that decides accuracy, as used in the run.
+using SettingsList = std::vector<std::pair<std::string, std::string>>;
+
+class Simulator {
+ public:
+  virtual ~Simulator() = default;
+  virtual std::string engine() const = 0;
+  // Engine library version ("mujoco 2.2.2"), for provenance.
+  virtual std::string version() const = 0;
+  // Advances to time t (engines: to the last step not beyond t + half a step). Stops early
+  // when the status leaves Ok; never throws for a diverging engine.
+  virtual void advance_to(double t) = 0;
+  virtual Observation observe() const = 0;
+  virtual WorkCounters work() const = 0;
+  virtual RunStatus status() const = 0;
+  virtual double status_time() const = 0;
+  virtual std::string status_detail() const = 0;
+  virtual std::vector<Event> events() const = 0;
+  virtual SettingsList settings() const = 0;
+  // Notes on approximations in force (e.g. "rolling approximated by mu = 1e3").
+  virtual std::vector<std::string> notes() const { return {}; }
+};
+
+// Builds a simulator by engine name ("analytic", "bullet", "ode", "mujoco"); throws
+// std::invalid_argument for an unknown engine or an invalid setting.
+std::unique_ptr<Simulator> make_simulator(const std::string& engine, const Scene& scene);
+std::vector<std::string> available_engines();
+
+}  // namespace tippe

@@ -1,0 +1,2 @@
+// The `tippe` command line (placeholder).
+int main() { return 0; }
