@@ -52,6 +52,8 @@ class FixedStepSimulator : public Simulator {
   const Scene& scene() const { return scene_; }
   const BodyModel& body() const { return body_; }
   double dt() const { return dt_; }
+  // The engine's current time: steps taken times dt (engine_state().t must equal it).
+  double time() const { return static_cast<double>(n_steps_) * dt_; }
 
  private:
   void step_once();
