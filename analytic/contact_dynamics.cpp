@@ -1,0 +1,308 @@
+// Equations of motion under a contact mode: contact forces from the acceleration constraints.
+//
+// Why this form: the source (tippe_top_equations_ja.md) eliminates the contact force by hand
+// for the ball and for rolling only, with d and R hard-coded and a sign error in F_n2. Here the
+// forces at every active contact are the unknowns of one small linear system, written in the
+// lab frame with the general R_C, so every law works on the ball, the stem and both at once.
+// Each constraint row says that a component of the acceleration of the material point at C
+// vanishes: n . (a_G + dw/dt x R_C + w x (w x r_GO)) = 0, with r_GO the vector from G to the
+// centre of the contacting sphere (the lowest point moves over the sphere, the centre does not).
+#include "contact_dynamics.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace tippe {
+
+namespace {
+
+constexpr int kMaxUnknowns = 8;  // 2 contacts x (normal + 2 tangential + drilling)
+using MatN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns, kMaxUnknowns>;
+using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
+
+struct Column {  // generalized force per unit of an unknown
+  Vec3 f, tau;
+};
+struct Row {  // row . (a_G, dw/dt) + bias = 0
+  Vec3 f, tau;
+  double bias;
+};
+
+}  // namespace
+
+StateVector pack(const BodyState& x) {
+  return {x.p_WG.x(), x.p_WG.y(), x.p_WG.z(), x.v_WG.x(), x.v_WG.y(), x.v_WG.z(),
+          x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z(), x.w_B.x(), x.w_B.y(), x.w_B.z()};
+}
+
+BodyState unpack(const StateVector& y, double t) {
+  BodyState x;
+  x.t = t;
+  x.p_WG = Vec3(y[0], y[1], y[2]);
+  x.v_WG = Vec3(y[3], y[4], y[5]);
+  x.q_WB = Quat(y[6], y[7], y[8], y[9]);
+  x.w_B = Vec3(y[10], y[11], y[12]);
+  return x;
+}
+
+ContactGeometry ContactDynamics::geometry(const BodyState& x, int slot) const {
+  const Quat q = x.q_WB.normalized();
+  const Vec3 e_Z = q * Vec3::UnitZ();
+  ContactGeometry g;
+  g.radius = slot == 0 ? m_.R : m_.r;
+  g.r_GO_W = (slot == 0 ? m_.z_O() : m_.z_P()) * e_Z;
+  g.r_GC_W = g.r_GO_W - g.radius * Vec3::UnitZ();
+  return g;
+}
+
+Vec3 ContactDynamics::contact_velocity(const BodyState& x, int slot) const {
+  const Vec3 w_W = x.q_WB.normalized() * x.w_B;
+  return x.v_WG + w_W.cross(geometry(x, slot).r_GC_W);
+}
+
+ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode& mode, StateVector* dydt) const {
+  const BodyState x = unpack(y, 0.0);
+  const double qn2 = x.q_WB.squaredNorm();
+  const Quat q = x.q_WB.normalized();
+  const Eigen::Matrix3d R_WB = q.toRotationMatrix();
+  const Vec3 w_W = R_WB * x.w_B;
+  const Vec3 I_B(m_.A, m_.A, m_.C);
+  const Eigen::Matrix3d I_W = R_WB * I_B.asDiagonal() * R_WB.transpose();
+  const Eigen::Matrix3d Iinv_W = R_WB * I_B.cwiseInverse().asDiagonal() * R_WB.transpose();
+  const Vec3 e_z = Vec3::UnitZ();
+
+  ContactForces out;
+  Vec3 F_known = -m_.M * m_.g * e_z;
+  Vec3 T_known = -w_W.cross(I_W * w_W);
+  Column cols[kMaxUnknowns];
+  Row rows[kMaxUnknowns];
+  int n = 0;
+  struct SlotIndex {
+    int normal = -1, tangential = -1, drill = -1;
+    Vec3 normal_dir = Vec3::UnitZ();
+    double drill_coeff = 0.0;
+  } idx[2];
+
+  for (int s = 0; s < 2; ++s) {
+    const ContactSlot& slot = mode.slot[s];
+    if (!slot.active) continue;
+    const ContactGeometry g = geometry(x, s);
+    const Vec3& r = g.r_GC_W;
+    Vec3 slip = x.v_WG + w_W.cross(r);
+    slip.z() = 0.0;
+    out.slip_W[s] = slip;
+    const Vec3 centripetal = w_W.cross(w_W.cross(g.r_GO_W));
+    auto add_row = [&](const Vec3& dir) {
+      rows[n - 1] = {dir, r.cross(dir), dir.dot(centripetal)};
+    };
+    // Normal force, carrying the sliding friction and drilling torque that scale with it.
+    Vec3 fdir = e_z;
+    if (c_.friction == FrictionLaw::Coulomb && !slot.stick) {
+      const double speed = slip.norm();
+      const Vec3 dir = speed > 0.0 ? Vec3(slip / speed) : slot.slip_dir_W;
+      fdir -= c_.mu * dir;
+    }
+    if (c_.friction == FrictionLaw::Viscous) {
+      F_known += -c_.k * slip;
+      T_known += r.cross(-c_.k * slip);
+    }
+    double drill_coeff = 0.0;
+    if (c_.drilling > 0.0 && !slot.drill_stick) {
+      const double spin_z = w_W.z();
+      drill_coeff = spin_z > 0 ? -c_.drilling : (spin_z < 0 ? c_.drilling : 0.0);
+    }
+    idx[s].normal = n;
+    idx[s].normal_dir = fdir;
+    idx[s].drill_coeff = drill_coeff;
+    cols[n] = {fdir, r.cross(fdir) + drill_coeff * e_z};
+    ++n;
+    add_row(e_z);
+    if (slot.stick) {
+      idx[s].tangential = n;
+      for (const Vec3& dir : {Vec3(Vec3::UnitX()), Vec3(Vec3::UnitY())}) {
+        cols[n] = {dir, r.cross(dir)};
+        ++n;
+        add_row(dir);
+      }
+    }
+    if (slot.drill_stick) {
+      idx[s].drill = n;
+      cols[n] = {Vec3::Zero(), e_z};
+      ++n;
+      rows[n - 1] = {Vec3::Zero(), e_z, 0.0};
+    }
+  }
+
+  VecN u(n);
+  if (n > 0) {
+    MatN K(n, n);
+    VecN b(n);
+    const Vec3 a_free = F_known / m_.M;
+    const Vec3 alpha_free = Iinv_W * T_known;
+    for (int i = 0; i < n; ++i) {
+      b(i) = -(rows[i].f.dot(a_free) + rows[i].tau.dot(alpha_free) + rows[i].bias);
+      for (int j = 0; j < n; ++j)
+        K(i, j) = rows[i].f.dot(cols[j].f) / m_.M + rows[i].tau.dot(Iinv_W * cols[j].tau);
+    }
+    const auto lu = K.fullPivLu();
+    out.solvable = lu.isInvertible();
+    u = lu.solve(b);
+  }
+
+  Vec3 F = F_known, T = T_known;
+  for (int j = 0; j < n; ++j) {
+    F += cols[j].f * u(j);
+    T += cols[j].tau * u(j);
+  }
+  for (int s = 0; s < 2; ++s) {
+    if (idx[s].normal < 0) continue;
+    const double fn = u(idx[s].normal);
+    out.normal[s] = fn;
+    Vec3 f = fn * idx[s].normal_dir;
+    if (idx[s].tangential >= 0) f += u(idx[s].tangential) * Vec3::UnitX() + u(idx[s].tangential + 1) * Vec3::UnitY();
+    if (c_.friction == FrictionLaw::Viscous) f += -c_.k * out.slip_W[s];
+    out.force_W[s] = f;
+    out.drill_torque[s] = idx[s].drill >= 0 ? u(idx[s].drill) : idx[s].drill_coeff * fn;
+  }
+
+  if (dydt) {
+    const Vec3 a_G = F / m_.M;
+    const Vec3 wdot_B = R_WB.transpose() * (Iinv_W * T);
+    // Quaternion rate from body-frame omega, plus a term that pulls |q| back to 1 at the rate
+    // of the motion: the unit sphere is invariant, so the exact solution is unchanged.
+    const double kappa = std::max(1.0, x.w_B.norm());
+    const double qw = y[6], qx = y[7], qy = y[8], qz = y[9];
+    const double wx = x.w_B.x(), wy = x.w_B.y(), wz = x.w_B.z();
+    const double pull = kappa * (1.0 - qn2);
+    StateVector& d = *dydt;
+    d[0] = x.v_WG.x(); d[1] = x.v_WG.y(); d[2] = x.v_WG.z();
+    d[3] = a_G.x(); d[4] = a_G.y(); d[5] = a_G.z();
+    d[6] = 0.5 * (-qx * wx - qy * wy - qz * wz) + pull * qw;
+    d[7] = 0.5 * (qw * wx + qy * wz - qz * wy) + pull * qx;
+    d[8] = 0.5 * (qw * wy + qz * wx - qx * wz) + pull * qy;
+    d[9] = 0.5 * (qw * wz + qx * wy - qy * wx) + pull * qz;
+    d[10] = wdot_B.x(); d[11] = wdot_B.y(); d[12] = wdot_B.z();
+  }
+  return out;
+}
+
+BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touching, std::array<bool, 2>* kept,
+                                  std::array<double, 2>* normal_impulse) const {
+  const Quat q = x.q_WB.normalized();
+  const Eigen::Matrix3d R_WB = q.toRotationMatrix();
+  const Vec3 I_B(m_.A, m_.A, m_.C);
+  const Eigen::Matrix3d Iinv_W = R_WB * I_B.cwiseInverse().asDiagonal() * R_WB.transpose();
+  const Vec3 w_W = q * x.w_B;
+  ContactGeometry g[2] = {geometry(x, 0), geometry(x, 1)};
+  Vec3 v_pre[2];
+  for (int s = 0; s < 2; ++s) v_pre[s] = x.v_WG + w_W.cross(g[s].r_GC_W);
+
+  // Velocity change of contact point i per unit impulse f at contact j.
+  auto response = [&](int i, int j, const Vec3& f) {
+    const Vec3 dw = Iinv_W * g[j].r_GC_W.cross(f);
+    return Vec3(f / m_.M + dw.cross(g[i].r_GC_W));
+  };
+  // Tangential impulses: rolling stops the whole contact velocity; Coulomb tries that and,
+  // outside the cone, slides along the pre-impact slip; viscous and none have no impulsive
+  // friction (a finite force transmits no impulse).
+  const bool full_stop = c_.friction == FrictionLaw::Rolling || c_.friction == FrictionLaw::Coulomb;
+
+  struct Solution {
+    bool ok = false;
+    Vec3 P[2] = {Vec3::Zero(), Vec3::Zero()};
+  };
+  auto solve = [&](std::array<bool, 2> in_set, std::array<bool, 2> sliding) {
+    Solution sol;
+    Column cols[6];
+    int owner[6], n = 0;
+    std::array<int, 2> first{-1, -1};
+    Row rows[6];
+    for (int s = 0; s < 2; ++s) {
+      if (!in_set[s]) continue;
+      first[s] = n;
+      Vec3 ndir = Vec3::UnitZ();
+      if (sliding[s]) {
+        Vec3 t = v_pre[s];
+        t.z() = 0;
+        if (t.norm() > 0) ndir -= c_.mu * t.normalized();
+      }
+      cols[n] = {ndir, Vec3::Zero()};
+      rows[n] = {Vec3::UnitZ(), Vec3::Zero(), v_pre[s].z()};
+      owner[n++] = s;
+      if (full_stop && !sliding[s]) {
+        for (int a = 0; a < 2; ++a) {
+          const Vec3 dir = a == 0 ? Vec3(Vec3::UnitX()) : Vec3(Vec3::UnitY());
+          cols[n] = {dir, Vec3::Zero()};
+          rows[n] = {dir, Vec3::Zero(), v_pre[s].dot(dir)};
+          owner[n++] = s;
+        }
+      }
+    }
+    MatN K(n, n);
+    VecN b(n);
+    for (int i = 0; i < n; ++i) {
+      b(i) = -rows[i].bias;
+      for (int j = 0; j < n; ++j) K(i, j) = rows[i].f.dot(response(owner[i], owner[j], cols[j].f));
+    }
+    const auto lu = K.fullPivLu();
+    if (!lu.isInvertible()) return sol;
+    const VecN u = lu.solve(b);
+    for (int j = 0; j < n; ++j) sol.P[owner[j]] += cols[j].f * u(j);
+    sol.ok = true;
+    for (int s = 0; s < 2; ++s) {
+      if (!in_set[s]) continue;
+      if (sol.P[s].z() < 0) sol.ok = false;
+    }
+    // Contacts left out of the set must not approach the floor afterwards.
+    for (int s = 0; s < 2; ++s) {
+      if (!touching[s] || in_set[s]) continue;
+      Vec3 v = v_pre[s];
+      for (int j = 0; j < 2; ++j) v += response(s, j, sol.P[j]);
+      if (v.z() < -1e-12 * std::max(1.0, v_pre[s].norm())) sol.ok = false;
+    }
+    return sol;
+  };
+
+  const std::array<std::array<bool, 2>, 3> sets = {{{true, false}, {false, true}, {true, true}}};
+  Solution best;
+  for (const auto& set : sets) {
+    if ((set[0] && !touching[0]) || (set[1] && !touching[1])) continue;
+    std::array<bool, 2> sliding{false, false};
+    Solution sol = solve(set, sliding);
+    if (sol.ok && c_.friction == FrictionLaw::Coulomb) {
+      bool redo = false;
+      for (int s = 0; s < 2; ++s) {
+        const double pt = std::hypot(sol.P[s].x(), sol.P[s].y());
+        if (set[s] && pt > c_.mu * sol.P[s].z()) sliding[s] = redo = true;
+      }
+      if (redo) sol = solve(set, sliding);
+    }
+    if (sol.ok) {
+      best = sol;
+      break;
+    }
+  }
+  BodyState post = x;
+  if (!best.ok) {
+    if (kept) *kept = {false, false};
+    return post;
+  }
+  Vec3 dv = Vec3::Zero(), dL = Vec3::Zero();
+  for (int s = 0; s < 2; ++s) {
+    dv += best.P[s];
+    dL += g[s].r_GC_W.cross(best.P[s]);
+    if (normal_impulse) (*normal_impulse)[s] = best.P[s].z();
+  }
+  post.v_WG = x.v_WG + dv / m_.M;
+  const Vec3 w_post_W = w_W + Iinv_W * dL;
+  post.w_B = q.conjugate() * w_post_W;
+  if (kept) {
+    for (int s = 0; s < 2; ++s) {
+      const Vec3 v = post.v_WG + w_post_W.cross(g[s].r_GC_W);
+      (*kept)[s] = touching[s] && std::abs(v.z()) <= 1e-9 * std::max(1.0, v_pre[s].norm());
+    }
+  }
+  return post;
+}
+
+}  // namespace tippe

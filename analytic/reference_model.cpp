@@ -1,0 +1,480 @@
+// The analytic reference: Dormand-Prince 5(4) with dense output, events located by TOMS 748 root
+// finding on the dense output, mode changes (impacts, stick/slip, release) applied at the event.
+#include "reference_model.h"
+
+#include <boost/math/tools/toms748_solve.hpp>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+#include <sstream>
+
+#include "initial_state.h"
+
+namespace tippe {
+
+namespace odeint = boost::numeric::odeint;
+
+namespace {
+
+using Dopri = odeint::runge_kutta_dopri5<StateVector>;
+using Dense = decltype(odeint::make_dense_output(1.0, 1.0, 1.0, Dopri()));
+
+enum class EvKind { Inversion, Reversion, NormalForce, SlipReversal, ConeExit, DrillReversal, DrillConeExit, Touchdown };
+struct EvFn {
+  EvKind kind;
+  int slot;
+};
+
+const char* slot_name(int s) { return s == 0 ? "ball" : "stem"; }
+
+Surface surface_of(const ContactMode& m) {
+  const bool b = m.slot[0].active, s = m.slot[1].active;
+  return b && s ? Surface::Both : b ? Surface::Ball : s ? Surface::Stem : Surface::None;
+}
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+struct ReferenceModel::Impl {
+  ReferenceModel& owner;
+  ContactDynamics dyn;
+  RunSpec run;
+  bool flight_allowed;
+  ContactMode mode;
+  Dense stepper;
+  StateVector y_obs{};
+  std::vector<EvFn> fns;
+  std::vector<double> g_start;
+  std::array<Vec3, 2> ref_dir{Vec3::UnitX(), Vec3::UnitX()};
+  double drill_ref_sign = 1.0;
+  bool pending = false;
+  EvFn pending_fn{EvKind::Inversion, 0};
+  double pending_t = 0.0;
+  bool stem_touched = false;
+  double v_eps = 0.0, slip_eps = 0.0;
+  double dt_hint = 0.0;
+  long long events_in_burst = 0;
+  double burst_start = -1.0;
+
+  Impl(ReferenceModel& o, const Scene& scene)
+      : owner(o),
+        dyn(BodyModel::from_scene(scene), scene.contact),
+        run(scene.run),
+        flight_allowed(scene.contact.flight),
+        stepper(odeint::make_dense_output(scene.run.atol, scene.run.rtol, scene.run.duration / 64.0, Dopri())) {}
+
+  ContactForces forces_at(const StateVector& y, const ContactMode& m) {
+    ++owner.rhs_evals_;
+    return dyn.evaluate(y, m, nullptr);
+  }
+
+  void build_event_functions() {
+    const BodyModel& b = dyn.body();
+    const ContactSpec& c = dyn.contact();
+    fns = {{EvKind::Inversion, 0}, {EvKind::Reversion, 0}};
+    for (int s = 0; s < 2; ++s) {
+      if (s == 1 && !b.stem) continue;
+      const ContactSlot& slot = mode.slot[s];
+      if (slot.active) {
+        fns.push_back({EvKind::NormalForce, s});
+        if (c.friction == FrictionLaw::Coulomb) fns.push_back({slot.stick ? EvKind::ConeExit : EvKind::SlipReversal, s});
+        if (c.drilling > 0) fns.push_back({slot.drill_stick ? EvKind::DrillConeExit : EvKind::DrillReversal, s});
+      } else {
+        fns.push_back({EvKind::Touchdown, s});
+      }
+    }
+  }
+
+  void refresh_references(const StateVector& y) {
+    const ContactForces f = forces_at(y, mode);
+    for (int s = 0; s < 2; ++s) {
+      const double speed = f.slip_W[s].norm();
+      ref_dir[s] = speed > 0 ? Vec3(f.slip_W[s] / speed) : mode.slot[s].slip_dir_W;
+    }
+    const double wz = (unpack(y, 0).q_WB.normalized() * unpack(y, 0).w_B).z();
+    drill_ref_sign = wz >= 0 ? 1.0 : -1.0;
+  }
+
+  double g(const EvFn& fn, const StateVector& y, const ContactForces* f) {
+    const BodyState x = unpack(y, 0.0);
+    const Quat q = x.q_WB.normalized();
+    const ContactSpec& c = dyn.contact();
+    switch (fn.kind) {
+      case EvKind::Inversion: return (q * Vec3::UnitZ()).z();
+      case EvKind::Reversion: return -(q * Vec3::UnitZ()).z();
+      case EvKind::Touchdown: {
+        const ContactGeometry geo = dyn.geometry(x, fn.slot);
+        return x.p_WG.z() + geo.r_GC_W.z();
+      }
+      case EvKind::DrillReversal: return drill_ref_sign * (q * x.w_B).z();
+      default: break;
+    }
+    const ContactForces& cf = *f;
+    const int s = fn.slot;
+    switch (fn.kind) {
+      case EvKind::NormalForce: return cf.normal[s];
+      case EvKind::SlipReversal: return cf.slip_W[s].dot(ref_dir[s]);
+      case EvKind::ConeExit: return c.mu * cf.normal[s] - std::hypot(cf.force_W[s].x(), cf.force_W[s].y());
+      case EvKind::DrillConeExit: return c.drilling * cf.normal[s] - std::abs(cf.drill_torque[s]);
+      default: return 0.0;
+    }
+  }
+
+  std::vector<double> g_all(const StateVector& y) {
+    const ContactForces f = forces_at(y, mode);
+    std::vector<double> out(fns.size());
+    for (size_t i = 0; i < fns.size(); ++i) out[i] = g(fns[i], y, &f);
+    return out;
+  }
+
+  StateVector state_at(double t) {
+    StateVector y;
+    if (t >= stepper.current_time()) return stepper.current_state();
+    stepper.calc_state(t, y);
+    return y;
+  }
+
+  double locate(const EvFn& fn, double a, double b, double ga, double gb) {
+    auto f = [&](double t) {
+      const StateVector y = state_at(t);
+      const ContactForces cf = forces_at(y, mode);
+      return g(fn, y, &cf);
+    };
+    // Event times to ~4 ulp of the time value: far inside the 1e-9 relative the design asks.
+    auto tol = [](double lo, double hi) { return std::abs(hi - lo) <= 8e-16 * std::max(1.0, std::abs(hi)); };
+    boost::uintmax_t iters = 200;
+    const auto r = boost::math::tools::toms748_solve(f, a, b, ga, gb, tol, iters);
+    // The earliest time at which the event function has crossed (g <= 0).
+    return r.second;
+  }
+
+  // Second derivative of the gap of slot k (acceleration of its sphere centre along z).
+  double gap_acceleration(const StateVector& y, const ContactMode& m, int k) {
+    StateVector dy;
+    ++owner.rhs_evals_;
+    dyn.evaluate(y, m, &dy);
+    const BodyState x = unpack(y, 0);
+    const Quat q = x.q_WB.normalized();
+    const Vec3 w_W = q * x.w_B, wdot_W = q * Vec3(dy[10], dy[11], dy[12]);
+    const Vec3 r_GO = dyn.geometry(x, k).r_GO_W;
+    return dy[5] + wdot_W.cross(r_GO).z() + w_W.cross(w_W.cross(r_GO)).z();
+  }
+
+  void restart(double t, const StateVector& y, double first_dt = 0.0) {
+    double dt = dt_hint > 0 ? dt_hint : 1e-4;
+    if (first_dt > 0) dt = std::min(dt, first_dt);
+    stepper.initialize(y, t, dt);
+    build_event_functions();
+    refresh_references(y);
+    g_start = g_all(y);
+    pending = false;
+  }
+
+  void step() {
+    const auto [t0, t1] = stepper.do_step([this](const StateVector& y, StateVector& dy, double) {
+      ++owner.rhs_evals_;
+      dyn.evaluate(y, mode, &dy);
+    });
+    ++owner.steps_;
+    dt_hint = stepper.current_time_step();
+    const double tm = 0.5 * (t0 + t1);
+    StateVector ym;
+    stepper.calc_state(tm, ym);
+    const StateVector y1 = stepper.current_state();
+    const std::vector<double> gm = g_all(ym), g1 = g_all(y1);
+    double best_t = t1 + 1.0;
+    int best = -1;
+    std::vector<std::pair<double, int>> found;
+    for (size_t i = 0; i < fns.size(); ++i) {
+      double te;
+      if (g_start[i] > 0 && gm[i] <= 0) te = locate(fns[i], t0, tm, g_start[i], gm[i]);
+      else if (gm[i] > 0 && g1[i] <= 0) te = locate(fns[i], tm, t1, gm[i], g1[i]);
+      else continue;
+      found.emplace_back(te, static_cast<int>(i));
+      const bool records_only = fns[i].kind == EvKind::Inversion || fns[i].kind == EvKind::Reversion;
+      if (!records_only && te < best_t) {
+        best_t = te;
+        best = static_cast<int>(i);
+      }
+    }
+    std::sort(found.begin(), found.end());
+    for (const auto& [te, i] : found) {
+      if (best >= 0 && te > best_t) break;
+      if (fns[i].kind == EvKind::Inversion) owner.events_.push_back({"inversion", te, "theta crosses 90 deg downward", 0.0});
+      if (fns[i].kind == EvKind::Reversion) owner.events_.push_back({"reversion", te, "theta crosses 90 deg back", 0.0});
+    }
+    if (best >= 0) {
+      pending = true;
+      pending_fn = fns[best];
+      pending_t = best_t;
+      return;
+    }
+    g_start = g1;
+    refresh_references(y1);
+  }
+
+  ContactMode settle(const StateVector& y, std::array<bool, 2> candidates, const ContactMode& prev) {
+    const ContactSpec& c = dyn.contact();
+    ContactMode m;
+    const BodyState x = unpack(y, 0);
+    for (int s = 0; s < 2; ++s) {
+      ContactSlot& slot = m.slot[s];
+      slot.active = candidates[s];
+      slot.slip_dir_W = prev.slot[s].slip_dir_W;
+      slot.drill_stick = prev.slot[s].active && prev.slot[s].drill_stick;
+      if (c.friction == FrictionLaw::Rolling) slot.stick = true;
+      if (c.friction == FrictionLaw::Coulomb) {
+        Vec3 v = dyn.contact_velocity(x, s);
+        v.z() = 0;
+        slot.stick = v.norm() <= slip_eps;
+        if (!slot.stick) slot.slip_dir_W = v.normalized();
+      }
+    }
+    for (int iter = 0; iter < 6; ++iter) {
+      const ContactForces f = forces_at(y, m);
+      int worst = -1;
+      for (int s = 0; s < 2; ++s)
+        if (m.slot[s].active && f.normal[s] < 0 && (worst < 0 || f.normal[s] < f.normal[worst])) worst = s;
+      if (worst >= 0) {
+        m.slot[worst].active = false;
+        continue;
+      }
+      bool changed = false;
+      for (int s = 0; s < 2; ++s) {
+        ContactSlot& slot = m.slot[s];
+        if (!slot.active) continue;
+        if (c.friction == FrictionLaw::Coulomb && slot.stick) {
+          const Vec3 ft(f.force_W[s].x(), f.force_W[s].y(), 0.0);
+          if (ft.norm() > c.mu * f.normal[s]) {
+            slot.stick = false;
+            slot.slip_dir_W = -ft.normalized();
+            changed = true;
+          }
+        }
+        if (slot.drill_stick && std::abs(f.drill_torque[s]) > c.drilling * f.normal[s]) {
+          slot.drill_stick = false;
+          changed = true;
+        }
+      }
+      if (!changed) break;
+    }
+    return m;
+  }
+
+  // Puts the held contact exactly on the floor with no normal velocity (removes integration
+  // drift of the order of the tolerance at each restart).
+  StateVector project(const StateVector& y) {
+    BodyState x = unpack(y, 0);
+    x.q_WB.normalize();
+    const int s = mode.slot[0].active ? 0 : (mode.slot[1].active ? 1 : -1);
+    if (s >= 0) {
+      const ContactGeometry geo = dyn.geometry(x, s);
+      const Vec3 w_W = x.q_WB * x.w_B;
+      x.p_WG.z() = -geo.r_GC_W.z();
+      x.v_WG.z() = -w_W.cross(geo.r_GO_W).z();
+      if (mode.slot[s].stick && !(mode.slot[0].active && mode.slot[1].active)) {
+        Vec3 slip = dyn.contact_velocity(x, s);
+        slip.z() = 0;
+        x.v_WG -= slip;
+      }
+    }
+    return pack(x);
+  }
+
+  void set_mode(const ContactMode& m, double t) {
+    const Surface before = surface_of(mode), after = surface_of(m);
+    mode = m;
+    if (before != after) {
+      owner.events_.push_back({"switch", t, std::string(to_string(before)) + " -> " + to_string(after),
+                               static_cast<double>(static_cast<int>(after))});
+      if (after == Surface::Both) owner.events_.push_back({"two_contact", t, "ball and stem held together", 0.0});
+    }
+  }
+
+  void end(ReferenceStatus status, double t, const std::string& why, const StateVector& y) {
+    owner.status_ = status;
+    owner.status_time_ = t;
+    owner.status_detail_ = why;
+    owner.events_.push_back({status == ReferenceStatus::ContactLost ? "contact_lost" : "failed", t, why, 0.0});
+    owner.t_obs_ = t;
+    y_obs = y;
+  }
+
+  void handle(const EvFn& fn, double te) {
+    StateVector y = state_at(te);
+    const BodyState x = unpack(y, te);
+    const ContactSpec& c = dyn.contact();
+    const int s = fn.slot;
+    // Guard against an endless sequence of events in a vanishing time (e.g. chattering).
+    if (burst_start < 0 || te - burst_start > 1e-9 * std::max(1.0, run.duration)) {
+      burst_start = te;
+      events_in_burst = 0;
+    }
+    if (++events_in_burst > 1000) return end(ReferenceStatus::Failed, te, "event accumulation: more than 1000 events within 1e-9 of the run", y);
+    ContactMode next = mode;
+    double first_dt = 0.0;
+    switch (fn.kind) {
+      case EvKind::NormalForce: {
+        next.slot[s].active = false;
+        const double tilt_deg = tilt(x.q_WB.normalized()) * 180.0 / M_PI;
+        if (!next.any_active()) {
+          if (!flight_allowed)
+            return end(ReferenceStatus::ContactLost, te,
+                       std::string("F_n reaches 0 on the ") + slot_name(s) + " at tilt " + fmt(tilt_deg) + " deg", y);
+          owner.events_.push_back({"flight", te, std::string("leaves the floor from the ") + slot_name(s), tilt_deg});
+        }
+        std::array<bool, 2> cand{next.slot[0].active, next.slot[1].active};
+        next = settle(y, cand, next);
+        break;
+      }
+      case EvKind::SlipReversal: {
+        Vec3 v = dyn.contact_velocity(x, s);
+        v.z() = 0;
+        if (v.norm() <= slip_eps) {
+          ContactMode trial = next;
+          trial.slot[s].stick = true;
+          const ContactForces f = forces_at(y, trial);
+          const Vec3 ft(f.force_W[s].x(), f.force_W[s].y(), 0.0);
+          if (ft.norm() <= c.mu * f.normal[s]) {
+            next = trial;
+            owner.events_.push_back({"stick", te, std::string("slip vanishes on the ") + slot_name(s), ft.norm() / f.normal[s]});
+          } else {
+            next.slot[s].slip_dir_W = -ft.normalized();
+          }
+        }
+        break;
+      }
+      case EvKind::ConeExit: {
+        const ContactForces f = forces_at(y, mode);
+        const Vec3 ft(f.force_W[s].x(), f.force_W[s].y(), 0.0);
+        next.slot[s].stick = false;
+        next.slot[s].slip_dir_W = ft.norm() > 0 ? Vec3(-ft.normalized()) : ref_dir[s];
+        owner.events_.push_back({"slip", te, std::string("friction leaves the cone on the ") + slot_name(s), 0.0});
+        break;
+      }
+      case EvKind::DrillReversal: {
+        ContactMode trial = next;
+        trial.slot[s].drill_stick = true;
+        const ContactForces f = forces_at(y, trial);
+        if (std::abs(f.drill_torque[s]) <= c.drilling * f.normal[s]) {
+          next = trial;
+          owner.events_.push_back({"drill_stick", te, std::string("spin about the vertical stops on the ") + slot_name(s), 0.0});
+        }
+        break;
+      }
+      case EvKind::DrillConeExit:
+        next.slot[s].drill_stick = false;
+        owner.events_.push_back({"drill_slip", te, "drilling torque leaves its bound", 0.0});
+        break;
+      case EvKind::Touchdown: {
+        std::array<bool, 2> touching{mode.slot[0].active || s == 0, mode.slot[1].active || s == 1};
+        std::array<double, 2> impulse{0, 0};
+        const BodyState post = dyn.impact(x, touching, nullptr, &impulse);
+        const BodyModel& b = dyn.body();
+        const double removed = energy(b, x) - energy(b, post);
+        owner.events_.push_back({"impact", te, std::string(slot_name(s)) + " touches down", removed});
+        if (s == 1 && !stem_touched) {
+          stem_touched = true;
+          owner.events_.push_back({"stem_contact", te, "first stem touchdown", removed});
+        }
+        std::array<bool, 2> cand{false, false};
+        for (int k = 0; k < 2; ++k) {
+          // A contact that separates slower than v_eps would only come back in a cascade of
+          // ever smaller impacts: it is held instead (the two-contact phase).
+          if (touching[k]) cand[k] = dyn.contact_velocity(post, k).z() <= v_eps;
+        }
+        y = pack(post);
+        for (int k = 0; k < 2; ++k) {
+          // A contact released with a small separation velocity comes back after about
+          // 2 v / |a|: the first step must not jump over that return (the gap starts at 0,
+          // so only later steps can bracket the next touchdown).
+          if (!touching[k] || cand[k]) continue;
+          const double v = dyn.contact_velocity(post, k).z();
+          ContactMode trial = mode;
+          trial.slot[0].active = cand[0];
+          trial.slot[1].active = cand[1];
+          const double a = gap_acceleration(y, trial, k);
+          if (a < 0) first_dt = first_dt > 0 ? std::min(first_dt, 0.25 * 2 * v / -a) : 0.25 * 2 * v / -a;
+        }
+        if (!cand[0] && !cand[1]) {
+          next = mode;
+          next.slot[0].active = next.slot[1].active = false;
+          if (!flight_allowed) return end(ReferenceStatus::ContactLost, te, "bounces off the floor after an impact", y);
+          owner.events_.push_back({"flight", te, "leaves the floor after an impact", 0.0});
+        } else {
+          next = settle(y, cand, mode);
+        }
+        if (!mode.any_active()) owner.events_.push_back({"touchdown", te, std::string(slot_name(s)) + " lands", removed});
+        break;
+      }
+      default:
+        break;
+    }
+    set_mode(next, te);
+    if (!mode.any_active() && !flight_allowed) return end(ReferenceStatus::ContactLost, te, "no contact can hold", y);
+    restart(te, project(y), first_dt);
+  }
+};
+
+ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene(scene)) {
+  impl_ = std::make_unique<Impl>(*this, scene);
+  const BodyState x0 = scene_initial_state(scene);
+  const double v_scale = std::max({x0.v_WG.norm(), x0.w_B.norm() * body_.R, std::sqrt(body_.g * body_.R)});
+  impl_->v_eps = 1e-7 * v_scale;
+  impl_->slip_eps = std::max(1e-7, 10.0 * scene.run.rtol) * v_scale;
+  const double period = std::min(2 * M_PI / std::max(x0.w_B.norm(), 1e-9), std::sqrt(body_.R / body_.g));
+  impl_->dt_hint = 1e-3 * period;
+  const StateVector y0 = pack(x0);
+  ContactMode none;
+  impl_->mode = impl_->settle(y0, {true, false}, none);
+  impl_->y_obs = y0;
+  if (!impl_->mode.any_active()) {
+    impl_->end(ReferenceStatus::ContactLost, 0.0, "F_n < 0 at the start: the floor cannot hold the top", y0);
+    return;
+  }
+  impl_->restart(0.0, impl_->project(y0));
+  impl_->y_obs = impl_->stepper.current_state();
+}
+
+ReferenceModel::~ReferenceModel() = default;
+
+void ReferenceModel::advance_to(double t) {
+  Impl& m = *impl_;
+  while (status_ == ReferenceStatus::Ok) {
+    if (m.pending) {
+      if (m.pending_t <= t) {
+        m.handle(m.pending_fn, m.pending_t);
+        continue;
+      }
+      break;
+    }
+    if (m.stepper.current_time() >= t) break;
+    m.step();
+    const StateVector& y = m.stepper.current_state();
+    for (double v : y)
+      if (!std::isfinite(v)) {
+        m.end(ReferenceStatus::Failed, m.stepper.current_time(), "non-finite state", y);
+        return;
+      }
+  }
+  if (status_ != ReferenceStatus::Ok) return;
+  t_obs_ = t;
+  m.y_obs = m.state_at(t);
+}
+
+BodyState ReferenceModel::state() const {
+  BodyState x = unpack(impl_->y_obs, t_obs_);
+  x.q_WB.normalize();
+  return x;
+}
+
+ContactForces ReferenceModel::forces() const { return impl_->dyn.evaluate(impl_->y_obs, impl_->mode, nullptr); }
+
+Surface ReferenceModel::contact_surface() const { return surface_of(impl_->mode); }
+
+}  // namespace tippe
