@@ -78,7 +78,7 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
   Row rows[kMaxUnknowns];
   int n = 0;
   struct SlotIndex {
-    int normal = -1, tangential = -1, drill = -1;
+    int normal = -1, tangential = -1, drill = -1, graze = -1;
     Vec3 normal_dir = Vec3::UnitZ();
     double drill_coeff = 0.0;
   } idx[2];
@@ -101,6 +101,15 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
       const double speed = slip.norm();
       const Vec3 dir = speed > 0.0 ? Vec3(slip / speed) : slot.slip_dir_W;
       fdir -= c_.mu * dir;
+    }
+    if (slot.graze) {
+      // Zero normal force; the unknown is the share of the viscous force that keeps the
+      // contact on the floor.
+      idx[s].graze = n;
+      cols[n] = {-c_.k * slip, r.cross(-c_.k * slip)};
+      ++n;
+      add_row(e_z);
+      continue;
     }
     if (c_.friction == FrictionLaw::Viscous) {
       F_known += -c_.k * slip;
@@ -155,6 +164,11 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
     T += cols[j].tau * u(j);
   }
   for (int s = 0; s < 2; ++s) {
+    if (idx[s].graze >= 0) {
+      out.graze_fraction[s] = u(idx[s].graze);
+      out.force_W[s] = -c_.k * u(idx[s].graze) * out.slip_W[s];
+      continue;
+    }
     if (idx[s].normal < 0) continue;
     const double fn = u(idx[s].normal);
     out.normal[s] = fn;
@@ -187,7 +201,7 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
 }
 
 BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touching, std::array<bool, 2>* kept,
-                                  std::array<double, 2>* normal_impulse) const {
+                                  std::array<double, 2>* normal_impulse, bool both_normal_only) const {
   const Quat q = x.q_WB.normalized();
   const Eigen::Matrix3d R_WB = q.toRotationMatrix();
   const Vec3 I_B(m_.A, m_.A, m_.C);
@@ -205,7 +219,7 @@ BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touchi
   // Tangential impulses: rolling stops the whole contact velocity; Coulomb tries that and,
   // outside the cone, slides along the pre-impact slip; viscous and none have no impulsive
   // friction (a finite force transmits no impulse).
-  const bool full_stop = c_.friction == FrictionLaw::Rolling || c_.friction == FrictionLaw::Coulomb;
+  const bool full_stop = !both_normal_only && (c_.friction == FrictionLaw::Rolling || c_.friction == FrictionLaw::Coulomb);
 
   struct Solution {
     bool ok = false;
@@ -249,6 +263,7 @@ BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touchi
     const VecN u = lu.solve(b);
     for (int j = 0; j < n; ++j) sol.P[owner[j]] += cols[j].f * u(j);
     sol.ok = true;
+    if (both_normal_only) return sol;
     for (int s = 0; s < 2; ++s) {
       if (!in_set[s]) continue;
       if (sol.P[s].z() < 0) sol.ok = false;
@@ -266,6 +281,7 @@ BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touchi
   const std::array<std::array<bool, 2>, 3> sets = {{{true, false}, {false, true}, {true, true}}};
   Solution best;
   for (const auto& set : sets) {
+    if (both_normal_only && !(set[0] && set[1])) continue;
     if ((set[0] && !touching[0]) || (set[1] && !touching[1])) continue;
     std::array<bool, 2> sliding{false, false};
     Solution sol = solve(set, sliding);

@@ -21,6 +21,10 @@ struct ContactSlot {
   bool active = false;  // held on the floor (normal constraint in force)
   bool stick = false;   // tangential velocity held at zero (rolling law, or Coulomb sticking)
   bool drill_stick = false;  // spin about the vertical held at zero (drilling friction sticking)
+  // Viscous law only: the contact touches with zero normal force and carries the fraction
+  // `graze_fraction` in [0, 1] of its viscous force that keeps it on the floor (Filippov's
+  // sliding mode between "held" and "lifted", see reference_model.cpp).
+  bool graze = false;
   Vec3 slip_dir_W = Vec3::UnitX();  // Coulomb sliding direction used while |v_C| is ~0
 };
 
@@ -34,6 +38,7 @@ struct ContactForces {
   std::array<double, 2> normal{0, 0};           // F_n per slot
   std::array<Vec3, 2> force_W{Vec3::Zero(), Vec3::Zero()};  // total force at each contact
   std::array<double, 2> drill_torque{0, 0};     // torque about +e_z at each contact
+  std::array<double, 2> graze_fraction{1, 1};   // share of the viscous force of a grazing contact
   std::array<Vec3, 2> slip_W{Vec3::Zero(), Vec3::Zero()};   // horizontal velocity of the material point at C
   bool solvable = true;
 };
@@ -54,12 +59,14 @@ class ContactDynamics {
   // Velocity of the material point at the lowest point of a surface (lab frame).
   Vec3 contact_velocity(const BodyState& x, int slot) const;
 
+  // With both_normal_only, the impulses act at both contacts along the normal only and may have
+  // either sign: a projection of the velocity onto the two-contact constraint.
   // Inelastic impact: impulses at the contacts in `touching` (slot flags) that leave no
   // contact approaching the floor, with tangential impulses by the friction law. Returns the
   // post-impact state (positions unchanged) and fills `post_mode_hint` with the contacts whose
   // normal velocity is ~0 afterwards and that received an impulse.
   BodyState impact(const BodyState& x, std::array<bool, 2> touching, std::array<bool, 2>* kept,
-                   std::array<double, 2>* normal_impulse) const;
+                   std::array<double, 2>* normal_impulse, bool both_normal_only = false) const;
 
   const BodyModel& body() const { return m_; }
   const ContactSpec& contact() const { return c_; }

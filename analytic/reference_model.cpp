@@ -4,6 +4,7 @@
 
 #include <boost/math/tools/toms748_solve.hpp>
 #include <boost/numeric/odeint.hpp>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -18,7 +19,7 @@ namespace {
 using Dopri = odeint::runge_kutta_dopri5<StateVector>;
 using Dense = decltype(odeint::make_dense_output(1.0, 1.0, 1.0, Dopri()));
 
-enum class EvKind { Inversion, Reversion, NormalForce, SlipReversal, ConeExit, DrillReversal, DrillConeExit, Touchdown };
+enum class EvKind { Inversion, Reversion, GrazeLift, GrazePress, NormalForce, SlipReversal, ConeExit, DrillReversal, DrillConeExit, Touchdown };
 struct EvFn {
   EvKind kind;
   int slot;
@@ -80,7 +81,10 @@ struct ReferenceModel::Impl {
     for (int s = 0; s < 2; ++s) {
       if (s == 1 && !b.stem) continue;
       const ContactSlot& slot = mode.slot[s];
-      if (slot.active) {
+      if (slot.active && slot.graze) {
+        fns.push_back({EvKind::GrazeLift, s});
+        fns.push_back({EvKind::GrazePress, s});
+      } else if (slot.active) {
         fns.push_back({EvKind::NormalForce, s});
         if (c.friction == FrictionLaw::Coulomb) fns.push_back({slot.stick ? EvKind::ConeExit : EvKind::SlipReversal, s});
         if (c.drilling > 0) fns.push_back({slot.drill_stick ? EvKind::DrillConeExit : EvKind::DrillReversal, s});
@@ -108,8 +112,11 @@ struct ReferenceModel::Impl {
       case EvKind::Inversion: return (q * Vec3::UnitZ()).z();
       case EvKind::Reversion: return -(q * Vec3::UnitZ()).z();
       case EvKind::Touchdown: {
+        // A released contact starts at gap ~0 (within the drift of the held contacts); the
+        // allowance of 1e-10 R lets a return to the floor right after a release still change
+        // sign. It shifts touchdown times by 1e-10 R / v_n, far below the 1e-9 asked for.
         const ContactGeometry geo = dyn.geometry(x, fn.slot);
-        return x.p_WG.z() + geo.r_GC_W.z();
+        return x.p_WG.z() + geo.r_GC_W.z() + 1e-10 * dyn.body().R;
       }
       case EvKind::DrillReversal: return drill_ref_sign * (q * x.w_B).z();
       default: break;
@@ -118,6 +125,8 @@ struct ReferenceModel::Impl {
     const int s = fn.slot;
     switch (fn.kind) {
       case EvKind::NormalForce: return cf.normal[s];
+      case EvKind::GrazeLift: return cf.graze_fraction[s];
+      case EvKind::GrazePress: return 1.0 - cf.graze_fraction[s];
       case EvKind::SlipReversal: return cf.slip_W[s].dot(ref_dir[s]);
       case EvKind::ConeExit: return c.mu * cf.normal[s] - std::hypot(cf.force_W[s].x(), cf.force_W[s].y());
       case EvKind::DrillConeExit: return c.drilling * cf.normal[s] - std::abs(cf.drill_torque[s]);
@@ -227,6 +236,7 @@ struct ReferenceModel::Impl {
       slot.active = candidates[s];
       slot.slip_dir_W = prev.slot[s].slip_dir_W;
       slot.drill_stick = prev.slot[s].active && prev.slot[s].drill_stick;
+      slot.graze = false;
       if (c.friction == FrictionLaw::Rolling) slot.stick = true;
       if (c.friction == FrictionLaw::Coulomb) {
         Vec3 v = dyn.contact_velocity(x, s);
@@ -242,6 +252,10 @@ struct ReferenceModel::Impl {
         if (m.slot[s].active && f.normal[s] < 0 && (worst < 0 || f.normal[s] < f.normal[worst])) worst = s;
       if (worst >= 0) {
         m.slot[worst].active = false;
+        if (m.any_active() && c.friction == FrictionLaw::Viscous && gap_acceleration(y, m, worst) < 0) {
+          // Neither held nor lifted is consistent (see the NormalForce event): graze.
+          m.slot[worst].active = m.slot[worst].graze = true;
+        }
         continue;
       }
       bool changed = false;
@@ -272,12 +286,32 @@ struct ReferenceModel::Impl {
     BodyState x = unpack(y, 0);
     x.q_WB.normalize();
     const int s = mode.slot[0].active ? 0 : (mode.slot[1].active ? 1 : -1);
+    if (mode.slot[0].active && mode.slot[1].active) {
+      // Both held: the tilt is fixed at the switching tilt. Rotate about the horizontal axis
+      // normal to e_Z to put it there exactly (removes the drift of the second contact).
+      const BodyModel& b = dyn.body();
+      const Vec3 e_Z = x.q_WB * Vec3::UnitZ();
+      const Vec3 axis = Vec3::UnitZ().cross(e_Z);
+      if (axis.norm() > 0) {
+        const double delta = std::acos(std::clamp(b.switch_cos, -1.0, 1.0)) - std::acos(std::clamp(e_Z.z(), -1.0, 1.0));
+        const Vec3 w_W = x.q_WB * x.w_B;
+        x.q_WB = (Quat(Eigen::AngleAxisd(delta, axis.normalized())) * x.q_WB).normalized();
+        x.w_B = x.q_WB.conjugate() * w_W;
+      }
+    }
     if (s >= 0) {
       const ContactGeometry geo = dyn.geometry(x, s);
       const Vec3 w_W = x.q_WB * x.w_B;
       x.p_WG.z() = -geo.r_GC_W.z();
       x.v_WG.z() = -w_W.cross(geo.r_GO_W).z();
-      if (mode.slot[s].stick && !(mode.slot[0].active && mode.slot[1].active)) {
+      if (mode.slot[0].active && mode.slot[1].active) {
+        // Two contacts held: remove the normal velocity of both with the smallest change of
+        // kinetic energy (a normal impulse at each), so that neither drifts off the floor.
+        std::array<double, 2> unused{0, 0};
+        const BodyState held = dyn.impact(x, {true, true}, nullptr, &unused, true);
+        x.v_WG = held.v_WG;
+        x.w_B = held.w_B;
+      } else if (mode.slot[s].stick) {
         Vec3 slip = dyn.contact_velocity(x, s);
         slip.z() = 0;
         x.v_WG -= slip;
@@ -321,6 +355,17 @@ struct ReferenceModel::Impl {
     switch (fn.kind) {
       case EvKind::NormalForce: {
         next.slot[s].active = false;
+        if (next.any_active() && c.friction == FrictionLaw::Viscous && gap_acceleration(y, next, s) < 0) {
+          // F_n of one of two held contacts reaches zero, but without it the other contact
+          // drives it straight back into the floor: with the viscous law the friction of a
+          // contact does not vanish with its normal force, so "held" and "lifted" do not
+          // join continuously. Filippov's continuation keeps the contact on the floor with
+          // zero normal force and the share of its viscous force that holds it there.
+          next = mode;
+          next.slot[s].graze = true;
+          owner.events_.push_back({"graze", te, std::string("F_n of the ") + slot_name(s) + " reaches 0; it touches without load", 0.0});
+          break;
+        }
         const double tilt_deg = tilt(x.q_WB.normalized()) * 180.0 / M_PI;
         if (!next.any_active()) {
           if (!flight_allowed)
@@ -367,6 +412,15 @@ struct ReferenceModel::Impl {
         }
         break;
       }
+      case EvKind::GrazeLift:
+        next.slot[s].graze = false;
+        next.slot[s].active = false;
+        owner.events_.push_back({"lift", te, std::string("the ") + slot_name(s) + " leaves the floor", 0.0});
+        break;
+      case EvKind::GrazePress:
+        next.slot[s].graze = false;
+        owner.events_.push_back({"press", te, std::string("the ") + slot_name(s) + " carries load again", 0.0});
+        break;
       case EvKind::DrillConeExit:
         next.slot[s].drill_stick = false;
         owner.events_.push_back({"drill_slip", te, "drilling torque leaves its bound", 0.0});
@@ -399,7 +453,17 @@ struct ReferenceModel::Impl {
           trial.slot[0].active = cand[0];
           trial.slot[1].active = cand[1];
           const double a = gap_acceleration(y, trial, k);
-          if (a < 0) first_dt = first_dt > 0 ? std::min(first_dt, 0.25 * 2 * v / -a) : 0.25 * 2 * v / -a;
+          if (a >= 0) continue;
+          const double back = 2 * v / -a;
+          if (back < dt_hint) {
+            // A bounce shorter than one integration step: hold the contact instead (the
+            // two-contact phase). This ends both Zeno cascades and the chatter between two
+            // single-contact modes that each drive the other contact into the floor; the
+            // bounce it skips is at most v^2 / 2|a| high, below the tolerance.
+            cand[k] = true;
+            continue;
+          }
+          first_dt = first_dt > 0 ? std::min(first_dt, 0.25 * back) : 0.25 * back;
         }
         if (!cand[0] && !cand[1]) {
           next = mode;
