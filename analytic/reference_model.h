@@ -34,6 +34,9 @@ class ReferenceModel {
   void advance_to(double t);
   double time() const { return t_obs_; }
   BodyState state() const;
+  // |q| of the integrated quaternion at the last accepted step, before normalization (the
+  // observed state is normalized; dense output between steps interpolates q component-wise).
+  double raw_quaternion_norm() const;
   // Contact forces, surface in contact and slip at the current time.
   ContactForces forces() const;
   Surface contact_surface() const;

@@ -75,6 +75,8 @@ void FixedStepSimulator::step_once() {
   work_.rhs_evaluations = n_steps_;
   work_.solver_iterations = engine_solver_iterations();
   const double t = static_cast<double>(n_steps_) * dt_;
+  const std::string failure = engine_failure();
+  if (!failure.empty()) return fail(RunStatus::Failed, t, failure);
   const Observation now = observe_kinematics(body_, engine_state());
   const BodyState& y = now.state;
   const bool finite = y.p_WG.allFinite() && y.v_WG.allFinite() && y.q_WB.coeffs().allFinite() &&

@@ -47,6 +47,8 @@ class FixedStepSimulator : public Simulator {
   virtual void apply_force_W(const Vec3& f_W, const Vec3& p_W) = 0;
   // Non-empty when the last step hit an engine limit (e.g. Bullet's angular velocity clamp).
   virtual std::string engine_limit_hit() const { return {}; }
+  // Non-empty when the engine itself failed in the last step (e.g. an ODE internal error).
+  virtual std::string engine_failure() const { return {}; }
   virtual long long engine_solver_iterations() const { return 0; }
 
   const Scene& scene() const { return scene_; }
