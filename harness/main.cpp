@@ -1,2 +1,43 @@
-// The `tippe` command line (placeholder).
-int main() { return 0; }
+// The `tippe` command line: parses the arguments and runs one subcommand (each lives in a cli_*.cpp).
+#include <iostream>
+#include <map>
+
+#include "cli.h"
+#include "scene_io.h"
+
+int main(int argc, char** argv) {
+  using namespace tippe;
+  CLI::App app{"tippe: the tippe-top verification bench"};
+  app.require_subcommand(1);
+  // Adding a subcommand: write cli_NAME.cpp with setup_NAME, declare it in cli.h, list it here.
+  const cli::Setup commands[] = {cli::setup_run, cli::setup_export_mjcf, cli::setup_info};
+  std::map<const CLI::App*, cli::Action> actions;
+  for (cli::Setup setup : commands) {
+    cli::Command c = setup(app);
+    actions[c.sub] = std::move(c.action);
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "tippe: error: " << e.what() << "\n(run with --help for usage)\n";
+    return 2;
+  }
+
+  try {
+    return actions.at(app.get_subcommands().front())();
+  } catch (const SceneError& e) {
+    std::cerr << "tippe: error: " << e.what() << "\n";
+    return 2;
+  } catch (const cli::UsageError& e) {
+    std::cerr << "tippe: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "tippe: error: internal: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,43 @@
+// Shared pieces of the `tippe` subcommands: how one registers, how errors map to exit codes.
+#pragma once
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace tippe::cli {
+
+// Invalid input found by a subcommand (unknown engine, bad setting): exit code 2, like SceneError.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A subcommand adds itself to the app and returns what to run once the command line is parsed.
+// The action returns the exit code; exceptions are mapped by main (SceneError, UsageError -> 2,
+// anything else -> 1).
+using Action = std::function<int()>;
+struct Command {
+  CLI::App* sub = nullptr;
+  Action action;
+};
+using Setup = Command (*)(CLI::App& app);
+
+// One function per subcommand, each in its own cli_NAME.cpp; main.cpp lists them.
+Command setup_run(CLI::App& app);
+Command setup_export_mjcf(CLI::App& app);
+Command setup_info(CLI::App& app);
+
+// The common SCENE.toml positional and repeatable --set KEY=VALUE option.
+inline void add_scene_options(CLI::App* sub, std::string& scene, std::vector<std::string>& sets) {
+  sub->add_option("scene", scene, "Scene file (TOML)")->required();
+  // allow_extra_args(false): each --set takes exactly one KEY=VALUE, so the scene may follow it.
+  sub->add_option("--set", sets, "Override a scene key, e.g. contact.mu=0.5 (repeatable)")
+      ->allow_extra_args(false)
+      ->take_all();
+}
+
+}  // namespace tippe::cli

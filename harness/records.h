@@ -1,0 +1,140 @@
+// Run records: running a scene on one simulator, its summary numbers, JSON and CSV writers, atomic files.
+#pragma once
+
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scene.h"
+#include "simulator.h"
+
+namespace tippe {
+
+struct Provenance {
+  std::string git_commit, compiler, cxx_flags;  // from build_info()
+  std::string date;                             // UTC, ISO 8601, when the run started
+  std::string hostname;
+};
+// Build info plus the current date and host.
+Provenance current_provenance();
+
+// Everything a run leaves behind except its trajectory.
+struct RunRecord {
+  std::string scene_name, scene_file, scene_hash;
+  nlohmann::json scene_spec;  // scene_to_json of the scene as run (overrides applied)
+  std::string engine, engine_version;
+  std::string status = "ok";  // to_string(RunStatus)
+  double status_time = 0.0;
+  std::string status_detail;
+  std::vector<Event> events;
+  SettingsList settings;
+  std::vector<std::string> notes;
+  WorkCounters work;
+  MassProperties mass;
+  bool inversion_possible = false;
+  Provenance provenance;
+
+  // From the samples and events. Values that have no sample to come from are NaN (JSON null).
+  std::optional<double> inversion_time;     // first "inversion" event
+  std::optional<double> stem_contact_time;  // first "stem_contact" event
+  long long samples = 0;
+  double final_time = 0.0;  // time of the last sample
+  double final_tilt = 0.0;
+  double energy_initial = 0.0, energy_final = 0.0;
+  double jellett_initial = 0.0;
+  // Largest |J - J_first| / max(|J_first|, tiny) within a run of samples on one surface (Ball or
+  // Stem; samples on None or Both end a run and are not counted). J is only conserved while the
+  // contact stays on one surface, so drift across a switch says nothing; a "switch" event between
+  // two samples (chattering faster than the sample interval) also ends a run.
+  double jellett_max_relative_drift = 0.0;
+  std::optional<double> jellett_drift_ball, jellett_drift_stem;  // absent: no run on that surface
+  double min_normal_force = 0.0;
+};
+
+// Receives every sample of a run as it is produced, so a run's memory does not grow with its length.
+struct SampleSink {
+  virtual ~SampleSink() = default;
+  virtual void write(const Observation& o) = 0;
+};
+
+// Folds samples into the summary numbers of a RunRecord (used by run_simulator; public so that
+// the numbers can be recomputed or tested on any sequence).
+class SampleSummary {
+ public:
+  // contact_switched: the simulator reported a "switch" event since the previous sample.
+  void add(const Observation& o, bool contact_switched = false);
+  void fill(RunRecord& r) const;
+
+ private:
+  long long n_ = 0;
+  Observation first_, last_;
+  double min_fn_ = 0.0;
+  Surface run_surface_ = Surface::None;  // None: not inside a run
+  double run_j0_ = 0.0;
+  std::optional<double> drift_ball_, drift_stem_;
+};
+
+// Called after every sample with the sample's time and the run's duration.
+using ProgressFn = std::function<void(double t, double duration)>;
+
+// Samples the simulator on the grid t_k = k * sample_interval, k = 0..floor(duration /
+// sample_interval) (the last point snapped to duration when within rounding), streams each
+// observation to `sink` (may be null), and stops after the first sample taken once the status
+// leaves ok (that sample carries its own, earlier, time). Fills every field of the record.
+RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, ProgressFn progress = {});
+// make_simulator(engine, scene) followed by run_simulator; std::invalid_argument from
+// make_simulator (unknown engine, bad setting) passes through.
+RunRecord run_scene(const Scene& scene, const std::string& engine, SampleSink* sink, ProgressFn progress = {});
+
+// summary.json. Non-finite numbers are written as null. Settings become an object (key order
+// is not kept: from_json returns them sorted by key).
+nlohmann::json to_json(const RunRecord& r);
+// Throws nlohmann::json::exception for a missing or mistyped field.
+RunRecord from_json(const nlohmann::json& j);
+
+// Writes `text` to `path.tmp.PID`, fsyncs it and renames it over `path`, so readers see the old
+// file or the new one, never a part. Throws std::runtime_error (temporary removed) on failure.
+void write_file_atomic(const std::string& path, const std::string& text);
+
+// The trajectory columns, in file order.
+const std::vector<std::string>& trajectory_columns();
+
+// Writes trajectory.csv: numbers with 17 significant digits (nan for an engine contact point
+// the engine did not report), surface as text. Rows go to `path.tmp.PID`; commit() renames it
+// to `path`. Destroyed without commit (an error, an exception) it removes the temporary.
+class CsvTrajectoryWriter : public SampleSink {
+ public:
+  explicit CsvTrajectoryWriter(std::string path);
+  ~CsvTrajectoryWriter() override;
+  CsvTrajectoryWriter(const CsvTrajectoryWriter&) = delete;
+  CsvTrajectoryWriter& operator=(const CsvTrajectoryWriter&) = delete;
+
+  void write(const Observation& o) override;
+  void commit();
+  const std::string& temp_path() const { return tmp_; }
+
+ private:
+  void fail(const std::string& what);
+  std::string path_, tmp_;
+  std::FILE* f_ = nullptr;
+  std::vector<char> buffer_;
+};
+
+// A trajectory.csv read back: numeric columns by name, surface as Surface codes (0..3).
+struct CsvTrajectory {
+  std::vector<std::string> columns;  // header order
+  std::map<std::string, std::vector<double>> values;  // every column but surface
+  std::vector<int> surface;
+  size_t rows() const { return surface.size(); }
+  // Throws std::out_of_range naming the column when it does not exist.
+  const std::vector<double>& column(const std::string& name) const;
+};
+// Throws std::runtime_error "FILE:LINE: reason" for a file that is not a trajectory.
+CsvTrajectory read_trajectory_csv(const std::string& path);
+
+}  // namespace tippe

@@ -1,0 +1,516 @@
+// Scene files: TOML -> Scene with every key checked, command-line overrides, and Scene -> JSON.
+#include "scene_io.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "adapters.h"
+#include "mass_properties.h"
+
+namespace tippe {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// A guard against a typo in sample_interval producing a trajectory of many gigabytes.
+constexpr double kMaxSamples = 1e8;
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(12);
+  os << v;
+  return os.str();
+}
+
+std::string join_path(const std::string& prefix, const std::string& key) {
+  return prefix.empty() ? key : prefix + "." + key;
+}
+
+const char* type_name(toml::node_type t) {
+  switch (t) {
+    case toml::node_type::none: return "nothing";
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+  }
+  return "?";
+}
+
+std::string fnv1a64_hex(const std::string& bytes, const std::vector<std::string>& overrides) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  auto feed = [&h](unsigned char c) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  };
+  for (unsigned char c : bytes) feed(c);
+  // A separator keeps {"a", "bc"} and {"ab", "c"} apart.
+  for (const auto& o : overrides) {
+    feed(0);
+    for (unsigned char c : o) feed(c);
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+bool is_bare_key(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+  });
+}
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return {};
+  const auto e = s.find_last_not_of(" \t");
+  return s.substr(b, e - b + 1);
+}
+
+// Interprets a parsed scene document; every error names the file and the dotted key.
+class Interpreter {
+ public:
+  Interpreter(std::string file, std::set<std::string> overridden)
+      : file_(std::move(file)), overridden_(std::move(overridden)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& why) const {
+    throw SceneError(file_ + ": " + key + ": " + why);
+  }
+
+  void apply_override(toml::table& root, const std::string& text) const {
+    const auto eq = text.find('=');
+    const std::string key = trim(text.substr(0, eq));
+    if (eq == std::string::npos || key.empty())
+      fail("--set", "malformed override \"" + text + "\" (expected KEY=VALUE)");
+    std::vector<std::string> parts;
+    std::stringstream ss(key);
+    for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
+    if (key.back() == '.' || parts.empty() ||
+        !std::all_of(parts.begin(), parts.end(), is_bare_key))
+      fail("--set", "malformed key \"" + key + "\" in \"" + text + "\" (expected dotted bare keys, e.g. contact.mu)");
+
+    const std::string value_text = trim(text.substr(eq + 1));
+    toml::table parsed;
+    bool is_toml = false;
+    try {
+      parsed = toml::parse("v = " + value_text);
+      is_toml = parsed.size() == 1 && parsed.contains("v");
+    } catch (const toml::parse_error&) {
+    }
+    if (!is_toml) {
+      parsed = toml::table{};
+      parsed.insert("v", value_text);
+    }
+
+    toml::table* tbl = &root;
+    std::string walked;
+    for (size_t i = 0; i + 1 < parts.size(); ++i) {
+      walked = join_path(walked, parts[i]);
+      toml::node* n = tbl->get(parts[i]);
+      if (!n) n = &tbl->insert(parts[i], toml::table{}).first->second;
+      tbl = n->as_table();
+      if (!tbl) fail("--set", "cannot set " + key + ": " + walked + " is not a table");
+    }
+    parsed.get("v")->visit([&](auto& v) { tbl->insert_or_assign(parts.back(), std::move(v)); });
+  }
+
+  Scene interpret(const toml::table& root, const std::string& default_name) {
+    Scene s;
+    keys(root, "", {"name", "description", "gravity", "body", "contact", "initial", "run", "engines"});
+    const auto name = opt_string(root, "", "name");
+    s.name = name.value_or(default_name);
+    if (!is_name(s.name))
+      fail("name", "\"" + s.name + "\"" + (name ? "" : " (the file's stem)") +
+                       " is not a usable name (letters, digits, '.', '_', '-'; it names output directories)");
+    s.description = opt_string(root, "", "description").value_or("");
+    if (s.description.find_first_of("\r\n") != std::string::npos) fail("description", "must be one line");
+    s.gravity = need_number(root, "", "gravity");
+    if (!(s.gravity > 0)) fail("gravity", "must be > 0, got " + num(s.gravity));
+
+    // contact first: whether a stem exists decides which body keys are required.
+    read_contact(need_table(root, "", "contact"), s.contact);
+    read_body(need_table(root, "", "body"), s);
+    read_initial(need_table(root, "", "initial"), s);
+    read_run(need_table(root, "", "run"), s.run);
+    if (const toml::node* e = root.get("engines")) read_engines(*e, s);
+    return s;
+  }
+
+ private:
+  static bool is_name(const std::string& n) {
+    return !n.empty() && n != "." && n != ".." && std::all_of(n.begin(), n.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+             c == '-' || c == '.';
+    });
+  }
+
+  void keys(const toml::table& t, const std::string& prefix, std::initializer_list<const char*> allowed) const {
+    for (auto&& [k, v] : t) {
+      (void)v;
+      const std::string key(k.str());
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+        std::string list;
+        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        const std::string path = join_path(prefix, key);
+        fail(path, "unknown key (expected one of: " + list + ")" +
+                       (overridden_.count(path) ? "; it was set with --set" : ""));
+      }
+    }
+  }
+
+  const toml::table& need_table(const toml::table& t, const std::string& prefix, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) fail(join_path(prefix, key), "missing (required table)");
+    const toml::table* tbl = n->as_table();
+    if (!tbl) fail(join_path(prefix, key), std::string("expected a table, got ") + type_name(n->type()));
+    return *tbl;
+  }
+
+  double to_number(const toml::node& n, const std::string& path) const {
+    double v;
+    if (const auto* f = n.as_floating_point()) v = f->get();
+    else if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
+    else fail(path, std::string("expected a number, got ") + type_name(n.type()));
+    if (!std::isfinite(v)) fail(path, "must be a finite number, got " + num(v));
+    return v;
+  }
+
+  std::optional<double> opt_number(const toml::table& t, const std::string& prefix, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    return to_number(*n, join_path(prefix, key));
+  }
+
+  double need_number(const toml::table& t, const std::string& prefix, const char* key) const {
+    auto v = opt_number(t, prefix, key);
+    if (!v) fail(join_path(prefix, key), "missing (required)");
+    return *v;
+  }
+
+  double need_positive(const toml::table& t, const std::string& prefix, const char* key) const {
+    const double v = need_number(t, prefix, key);
+    if (!(v > 0)) fail(join_path(prefix, key), "must be > 0, got " + num(v));
+    return v;
+  }
+
+  std::optional<bool> opt_bool(const toml::table& t, const std::string& prefix, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    const auto* b = n->as_boolean();
+    if (!b) fail(join_path(prefix, key), std::string("expected true or false, got ") + type_name(n->type()));
+    return b->get();
+  }
+
+  std::optional<std::string> opt_string(const toml::table& t, const std::string& prefix, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    const auto* s = n->as_string();
+    if (!s) fail(join_path(prefix, key), std::string("expected a string, got ") + type_name(n->type()));
+    return s->get();
+  }
+
+  std::optional<std::vector<double>> opt_numbers(const toml::table& t, const std::string& prefix, const char* key,
+                                                  size_t count) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    const std::string path = join_path(prefix, key);
+    const auto* a = n->as_array();
+    if (!a || a->size() != count)
+      fail(path, "expected an array of " + std::to_string(count) + " numbers, got " +
+                     (a ? "an array of " + std::to_string(a->size()) : std::string(type_name(n->type()))));
+    std::vector<double> out;
+    for (size_t i = 0; i < a->size(); ++i) out.push_back(to_number(*a->get(i), path + "[" + std::to_string(i) + "]"));
+    return out;
+  }
+
+  // A coefficient that belongs to another friction law: harmless only when it is 0.
+  void must_be_zero_if_present(const toml::table& t, const char* key, const char* law) const {
+    if (auto v = opt_number(t, "contact", key); v && *v != 0.0)
+      fail(join_path("contact", key), std::string("does not apply to friction = \"") + law +
+                                          "\" (only 0 is accepted), got " + num(*v));
+  }
+
+  void read_contact(const toml::table& t, ContactSpec& c) const {
+    keys(t, "contact", {"friction", "mu", "k", "drilling", "stem", "flight"});
+    const auto law = opt_string(t, "contact", "friction");
+    if (!law) fail("contact.friction", "missing (required: rolling, viscous, coulomb or none)");
+    if (*law == "rolling") c.friction = FrictionLaw::Rolling;
+    else if (*law == "viscous") c.friction = FrictionLaw::Viscous;
+    else if (*law == "coulomb") c.friction = FrictionLaw::Coulomb;
+    else if (*law == "none") c.friction = FrictionLaw::None;
+    else fail("contact.friction", "unknown law \"" + *law + "\" (expected rolling, viscous, coulomb or none)");
+
+    if (c.friction == FrictionLaw::Coulomb) {
+      c.mu = need_number(t, "contact", "mu");
+      if (!(c.mu >= 0)) fail("contact.mu", "must be >= 0, got " + num(c.mu));
+    } else {
+      must_be_zero_if_present(t, "mu", law->c_str());
+    }
+    if (c.friction == FrictionLaw::Viscous) {
+      c.k = need_number(t, "contact", "k");
+      if (!(c.k >= 0)) fail("contact.k", "must be >= 0, got " + num(c.k));
+    } else {
+      must_be_zero_if_present(t, "k", law->c_str());
+    }
+    if (c.friction == FrictionLaw::None) {
+      must_be_zero_if_present(t, "drilling", law->c_str());
+    } else {
+      c.drilling = opt_number(t, "contact", "drilling").value_or(0.0);
+      if (!(c.drilling >= 0)) fail("contact.drilling", "must be >= 0, got " + num(c.drilling));
+    }
+    c.stem = opt_bool(t, "contact", "stem").value_or(true);
+    c.flight = opt_bool(t, "contact", "flight").value_or(false);
+  }
+
+  void read_body(const toml::table& t, Scene& s) const {
+    static const char* const direct[] = {"mass", "com_offset", "inertia_transverse", "inertia_axial"};
+    keys(t, "body", {"sphere_radius", "stem_radius", "stem_length", "truncation_height", "density", "mass_model",
+                     "mass", "com_offset", "inertia_transverse", "inertia_axial"});
+    BodyGeometry& b = s.body;
+    b.sphere_radius = need_positive(t, "body", "sphere_radius");
+    if (s.contact.stem) {
+      b.stem_radius = need_positive(t, "body", "stem_radius");
+      b.stem_length = need_positive(t, "body", "stem_length");
+    } else {
+      // Without stem contact the stem may still carry mass, so its size is used when given.
+      if (t.contains("stem_radius")) b.stem_radius = need_positive(t, "body", "stem_radius");
+      if (t.contains("stem_length")) b.stem_length = need_positive(t, "body", "stem_length");
+    }
+    b.truncation_height = need_positive(t, "body", "truncation_height");
+    if (b.truncation_height > b.sphere_radius)
+      fail("body.truncation_height", "must be <= sphere_radius (" + num(b.sphere_radius) + "), got " +
+                                         num(b.truncation_height));
+    const auto problems = geometry_problems(b, s.contact.stem);
+    if (!problems.empty()) throw SceneError(body_message(problems.front()));
+
+    size_t given = 0;
+    for (const char* k : direct) given += t.contains(k) ? 1 : 0;
+    if (given == 4) {
+      for (const char* k : {"density", "mass_model"})
+        if (t.contains(k))
+          fail(join_path("body", k), "not used when mass, com_offset, inertia_transverse and inertia_axial are given; remove it");
+      b.mass_model = MassModel::Given;
+      b.density = 0.0;
+      MassProperties& m = s.mass;
+      m.mass = need_positive(t, "body", "mass");
+      m.com_offset = need_number(t, "body", "com_offset");
+      m.inertia_transverse = need_positive(t, "body", "inertia_transverse");
+      m.inertia_axial = need_positive(t, "body", "inertia_axial");
+      if (!(std::abs(m.com_offset) < b.sphere_radius))
+        fail("body.com_offset", "must lie in (-R, R) = (" + num(-b.sphere_radius) + ", " + num(b.sphere_radius) +
+                                    "), got " + num(m.com_offset));
+      if (m.inertia_axial > 2 * m.inertia_transverse)
+        fail("body.inertia_axial", "C = " + num(m.inertia_axial) + " exceeds 2A = " + num(2 * m.inertia_transverse) +
+                                       " (triangle inequality of an axisymmetric body)");
+      return;
+    }
+    if (given > 0) {
+      for (const char* k : direct)
+        if (!t.contains(k))
+          fail(join_path("body", k), "missing: mass properties given directly need all of mass, com_offset, "
+                                     "inertia_transverse and inertia_axial");
+    }
+    b.density = need_positive(t, "body", "density");
+    const auto model = opt_string(t, "body", "mass_model");
+    if (!model) fail("body.mass_model", "missing (required with density: \"solid\" or \"seed\")");
+    if (*model == "solid") b.mass_model = MassModel::Solid;
+    else if (*model == "seed") b.mass_model = MassModel::Seed;
+    else fail("body.mass_model", "unknown model \"" + *model + "\" (expected \"solid\" or \"seed\")");
+    try {
+      s.mass = compute_mass_properties(b);
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(body_message(e.what()));
+    }
+  }
+
+  // Messages from the mass-properties code start with "QUANTITY: "; when QUANTITY is a body
+  // key it becomes the dotted key, otherwise the whole message is the reason for "body".
+  std::string body_message(const std::string& what) const {
+    static const std::set<std::string> body_keys = {"sphere_radius", "stem_radius", "stem_length",
+                                                    "truncation_height", "density", "mass_model",
+                                                    "mass", "com_offset", "inertia_transverse",
+                                                    "inertia_axial"};
+    const auto colon = what.find(": ");
+    const bool keyed = colon != std::string::npos && body_keys.count(what.substr(0, colon));
+    return file_ + ": body" + (keyed ? "." : ": ") + what;
+  }
+
+  void read_initial(const toml::table& t, Scene& s) const {
+    keys(t, "initial", {"tilt", "spin", "omega", "velocity", "omega_along_contact"});
+    InitialSpec& in = s.initial;
+    in.tilt = need_number(t, "initial", "tilt");
+    if (!(in.tilt >= 0 && in.tilt <= kPi)) fail("initial.tilt", "must lie in [0, pi] rad, got " + num(in.tilt));
+    const auto spin = opt_number(t, "initial", "spin");
+    const auto omega = opt_numbers(t, "initial", "omega", 3);
+    if (spin && omega) fail("initial.omega", "give either spin or omega, not both");
+    if (!spin && !omega) fail("initial.spin", "missing (give spin or omega)");
+    if (spin) in.spin = *spin;
+    if (omega) {
+      in.omega_given = true;
+      std::copy(omega->begin(), omega->end(), in.omega_B.begin());
+    }
+    if (const auto v = opt_numbers(t, "initial", "velocity", 2)) {
+      if (s.contact.friction == FrictionLaw::Rolling)
+        fail("initial.velocity", "not allowed with friction = \"rolling\": the velocity of G is derived for rolling "
+                                 "(v_G = R_C x omega)");
+      in.velocity_given = true;
+      std::copy(v->begin(), v->end(), in.velocity.begin());
+    }
+    in.omega_along_contact = opt_bool(t, "initial", "omega_along_contact").value_or(false);
+    if (in.omega_along_contact && in.omega_given)
+      fail("initial.omega_along_contact", "takes its magnitude from spin; it cannot be combined with omega");
+  }
+
+  void read_run(const toml::table& t, RunSpec& r) const {
+    keys(t, "run", {"duration", "sample_interval", "rtol", "atol"});
+    r.duration = need_positive(t, "run", "duration");
+    r.sample_interval = need_positive(t, "run", "sample_interval");
+    if (r.sample_interval > r.duration)
+      fail("run.sample_interval", "must be <= duration (" + num(r.duration) + "), got " + num(r.sample_interval));
+    if (r.duration / r.sample_interval > kMaxSamples)
+      fail("run.sample_interval", "gives " + num(r.duration / r.sample_interval) + " samples, more than " +
+                                      num(kMaxSamples));
+    r.rtol = opt_number(t, "run", "rtol").value_or(r.rtol);
+    if (!(r.rtol > 0 && r.rtol <= 1e-2)) fail("run.rtol", "must lie in (0, 1e-2], got " + num(r.rtol));
+    r.atol = opt_number(t, "run", "atol").value_or(r.atol);
+    if (!(r.atol > 0 && r.atol <= 1)) fail("run.atol", "must lie in (0, 1], got " + num(r.atol));
+  }
+
+  SettingValue to_setting(const toml::node& n, const std::string& path) const {
+    if (const auto* b = n.as_boolean()) return b->get();
+    if (const auto* i = n.as_integer()) return static_cast<long long>(i->get());
+    if (n.is_floating_point()) return to_number(n, path);
+    if (const auto* s = n.as_string()) return s->get();
+    if (const auto* a = n.as_array()) {
+      std::vector<double> out;
+      for (size_t i = 0; i < a->size(); ++i) out.push_back(to_number(*a->get(i), path + "[" + std::to_string(i) + "]"));
+      return out;
+    }
+    fail(path, std::string("unsupported value (") + type_name(n.type()) +
+                   "; expected a boolean, number, string or array of numbers)");
+  }
+
+  void read_engines(const toml::node& node, Scene& s) const {
+    const auto* t = node.as_table();
+    if (!t) fail("engines", std::string("expected a table of [engines.NAME] tables, got ") + type_name(node.type()));
+    for (auto&& [name, table] : *t) {
+      const std::string prefix = "engines." + std::string(name.str());
+      const auto* et = table.as_table();
+      if (!et) fail(prefix, std::string("expected a table, got ") + type_name(table.type()));
+      auto& dst = s.engines[std::string(name.str())];
+      for (auto&& [k, v] : *et) dst[std::string(k.str())] = to_setting(v, prefix + "." + std::string(k.str()));
+    }
+    try {
+      validate_engine_settings(s);
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(file_ + ": " + e.what());
+    }
+  }
+
+  std::string file_;
+  std::set<std::string> overridden_;
+};
+
+}  // namespace
+
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SceneError(path + ": cannot read: is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path + ": cannot read: " + std::strerror(errno));
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (in.bad()) throw SceneError(path + ": cannot read: " + std::strerror(errno));
+  const std::string text = bytes.str();
+
+  toml::table root;
+  try {
+    root = toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    throw SceneError(path + ":" + std::to_string(e.source().begin.line) + ":" +
+                     std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
+  }
+
+  std::set<std::string> overridden;
+  for (const auto& o : overrides) overridden.insert(trim(o.substr(0, o.find('='))));
+  Interpreter interp(path, overridden);
+  for (const auto& o : overrides) interp.apply_override(root, o);
+
+  Scene s = interp.interpret(root, std::filesystem::path(path).stem().string());
+  s.source_file = path;
+  s.content_hash = fnv1a64_hex(text, overrides);
+  return s;
+}
+
+nlohmann::json setting_to_json(const SettingValue& value) {
+  return std::visit([](const auto& v) { return nlohmann::json(v); }, value);
+}
+
+nlohmann::json scene_to_json(const Scene& s) {
+  using nlohmann::json;
+  json engines = json::object();
+  for (const auto& [engine, table] : s.engines) {
+    json t = json::object();
+    for (const auto& [k, v] : table) t[k] = setting_to_json(v);
+    engines[engine] = t;
+  }
+  return json{
+      {"name", s.name},
+      {"description", s.description},
+      {"source_file", s.source_file},
+      {"content_hash", s.content_hash},
+      {"gravity", s.gravity},
+      {"body",
+       {{"sphere_radius", s.body.sphere_radius},
+        {"stem_radius", s.body.stem_radius},
+        {"stem_length", s.body.stem_length},
+        {"truncation_height", s.body.truncation_height},
+        {"density", s.body.density},
+        {"mass_model", to_string(s.body.mass_model)}}},
+      {"mass_properties",
+       {{"mass", s.mass.mass},
+        {"com_offset", s.mass.com_offset},
+        {"inertia_transverse", s.mass.inertia_transverse},
+        {"inertia_axial", s.mass.inertia_axial}}},
+      {"contact",
+       {{"friction", to_string(s.contact.friction)},
+        {"mu", s.contact.mu},
+        {"k", s.contact.k},
+        {"drilling", s.contact.drilling},
+        {"stem", s.contact.stem},
+        {"flight", s.contact.flight}}},
+      {"initial",
+       {{"tilt", s.initial.tilt},
+        {"omega_given", s.initial.omega_given},
+        {"spin", s.initial.spin},
+        {"omega", s.initial.omega_B},
+        {"velocity_given", s.initial.velocity_given},
+        {"velocity", s.initial.velocity},
+        {"omega_along_contact", s.initial.omega_along_contact}}},
+      {"run",
+       {{"duration", s.run.duration},
+        {"sample_interval", s.run.sample_interval},
+        {"rtol", s.run.rtol},
+        {"atol", s.run.atol}}},
+      {"engines", engines},
+  };
+}
+
+}  // namespace tippe

@@ -1,0 +1,61 @@
+// Scene files: TOML -> Scene with every key checked, command-line overrides, and Scene -> JSON.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scene.h"
+
+namespace tippe {
+
+// Invalid scene input. The message is always "FILE: KEY: reason" with KEY dotted
+// ("body.stem_radius", "engines.mujoco.timestep", "--set" for a malformed override), except
+// for TOML syntax errors, which read "FILE:LINE:COL: reason", and an unreadable file
+// ("FILE: cannot read: reason").
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Reads a scene file. `overrides` are "KEY=VALUE" strings (KEY dotted, VALUE a TOML value or,
+// if it does not parse as one, a bare string) applied to the parsed document before it is
+// interpreted, creating tables as needed.
+//
+// Rules beyond "every key known, every type right, every number finite" (integers are
+// accepted for floats, booleans are not numbers):
+//  - required: gravity (> 0), body.sphere_radius, body.truncation_height (0 < h <= R),
+//    contact.friction, initial.tilt ([0, pi]), one of initial.spin / initial.omega,
+//    run.duration (> 0), run.sample_interval (> 0, <= duration, at most 1e8 samples).
+//    body.stem_radius and body.stem_length are required unless contact.stem = false; when
+//    given they must be positive and, for every scene, pass geometry_problems(body, stem).
+//  - optional with defaults: name (file stem; letters, digits, '.', '_', '-'), description
+//    (one line), contact.drilling (0), contact.stem (true), contact.flight (false),
+//    initial.velocity (not given), initial.omega_along_contact (false), run.rtol (1e-10,
+//    in (0, 1e-2]), run.atol (1e-12, in (0, 1]).
+//  - mass: either density (> 0) and mass_model ("solid" | "seed"), both required, then
+//    compute_mass_properties(body); or all four of mass, com_offset, inertia_transverse,
+//    inertia_axial (MassModel::Given; density and mass_model must then be absent), with
+//    M, A, C > 0, |d| < R and C <= 2A.
+//  - friction laws: coulomb needs mu >= 0, viscous needs k >= 0. A coefficient of another law
+//    (mu with viscous, k with coulomb, ...) is accepted only when it is 0, so one template can
+//    carry every key without silently changing the physics; drilling (>= 0) applies to every
+//    law but "none", where it too must be 0.
+//  - initial: rolling derives the velocity of G, so initial.velocity is rejected with it;
+//    omega_along_contact takes its magnitude from spin and so cannot be combined with omega.
+//  - [engines.NAME] tables are copied into Scene::engines (bool, integer -> long long,
+//    float -> double, string, array of numbers -> vector<double>) and checked with
+//    validate_engine_settings.
+// Scene::content_hash is FNV-1a 64 (16 hex digits) over the file's bytes and the overrides;
+// Scene::source_file is `path` as given.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// Every field of a scene, its mass properties and engine tables, for run records.
+nlohmann::json scene_to_json(const Scene& scene);
+
+// One engine setting as JSON (arrays of numbers become JSON arrays).
+nlohmann::json setting_to_json(const SettingValue& value);
+
+}  // namespace tippe
