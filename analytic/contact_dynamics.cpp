@@ -98,8 +98,13 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
     // Normal force, carrying the sliding friction and drilling torque that scale with it.
     Vec3 fdir = e_z;
     if (c_.friction == FrictionLaw::Coulomb && !slot.stick) {
+      // Beyond a zero of the slip (reached along a line) s/|s| flips; taking the side of the
+      // slot's reference direction continues the sliding law smoothly through it, so the
+      // integrator never steps over a kink and the "slip vanishes" event is located on a
+      // smooth dense output. The reference is refreshed every step.
       const double speed = slip.norm();
-      const Vec3 dir = speed > 0.0 ? Vec3(slip / speed) : slot.slip_dir_W;
+      Vec3 dir = speed > 0.0 ? Vec3(slip / speed) : slot.slip_dir_W;
+      if (dir.dot(slot.slip_dir_W) < 0) dir = -dir;
       fdir -= c_.mu * dir;
     }
     if (slot.graze) {

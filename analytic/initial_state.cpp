@@ -26,9 +26,15 @@ BodyState scene_initial_state(const Scene& scene) {
   } else {
     x.v_WG = Vec3(scene.initial.velocity[0], scene.initial.velocity[1], 0.0);
   }
-  // v_Oz = 0: the ball centre moves horizontally while the ball touches the floor.
+  // v_Oz = 0: the ball centre moves horizontally while the ball touches the floor. A start
+  // above the floor (free flight) keeps v_Gz = 0 instead.
   const Vec3 e_Z = x.q_WB * Vec3::UnitZ();
-  x.v_WG.z() = -(w_W.cross(m.d * e_Z)).z();
+  if (scene.initial.height > 0) {
+    x.p_WG.z() += scene.initial.height;
+    x.v_WG.z() = 0.0;
+  } else {
+    x.v_WG.z() = -(w_W.cross(m.d * e_Z)).z();
+  }
   return x;
 }
 

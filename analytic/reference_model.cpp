@@ -99,6 +99,8 @@ struct ReferenceModel::Impl {
     for (int s = 0; s < 2; ++s) {
       const double speed = f.slip_W[s].norm();
       ref_dir[s] = speed > 0 ? Vec3(f.slip_W[s] / speed) : mode.slot[s].slip_dir_W;
+      if (ref_dir[s].dot(mode.slot[s].slip_dir_W) < 0) ref_dir[s] = -ref_dir[s];
+      mode.slot[s].slip_dir_W = ref_dir[s];
     }
     const double wz = (unpack(y, 0).q_WB.normalized() * unpack(y, 0).w_B).z();
     drill_ref_sign = wz >= 0 ? 1.0 : -1.0;
@@ -507,8 +509,14 @@ ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene
   impl_->dt_hint = 1e-3 * period;
   const StateVector y0 = pack(x0);
   ContactMode none;
-  impl_->mode = impl_->settle(y0, {true, false}, none);
   impl_->y_obs = y0;
+  if (scene.initial.height > 0) {
+    // Starts in free flight; touchdowns are events like any other.
+    impl_->mode = none;
+    impl_->restart(0.0, y0);
+    return;
+  }
+  impl_->mode = impl_->settle(y0, {true, false}, none);
   if (!impl_->mode.any_active()) {
     impl_->end(ReferenceStatus::ContactLost, 0.0, "F_n < 0 at the start: the floor cannot hold the top", y0);
     return;

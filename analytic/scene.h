@@ -52,6 +52,7 @@ struct InitialSpec {
   bool velocity_given = false;
   std::array<double, 2> velocity{0, 0};    // horizontal velocity of G
   bool omega_along_contact = false;        // omega parallel to R_C so that v_C = v_G
+  double height = 0.0;                     // lowest point of the ball above the floor (> 0: start in flight)
 };
 
 struct RunSpec {

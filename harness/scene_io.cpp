@@ -353,7 +353,7 @@ class Interpreter {
   }
 
   void read_initial(const toml::table& t, Scene& s) const {
-    keys(t, "initial", {"tilt", "spin", "omega", "velocity", "omega_along_contact"});
+    keys(t, "initial", {"tilt", "spin", "omega", "velocity", "omega_along_contact", "height"});
     InitialSpec& in = s.initial;
     in.tilt = need_number(t, "initial", "tilt");
     if (!(in.tilt >= 0 && in.tilt <= kPi)) fail("initial.tilt", "must lie in [0, pi] rad, got " + num(in.tilt));
@@ -376,6 +376,10 @@ class Interpreter {
     in.omega_along_contact = opt_bool(t, "initial", "omega_along_contact").value_or(false);
     if (in.omega_along_contact && in.omega_given)
       fail("initial.omega_along_contact", "takes its magnitude from spin; it cannot be combined with omega");
+    in.height = opt_number(t, "initial", "height").value_or(0.0);
+    if (!(in.height >= 0)) fail("initial.height", "must be >= 0, got " + num(in.height));
+    if (in.height > 0 && !s.contact.flight)
+      fail("initial.height", "a start above the floor needs contact.flight = true");
   }
 
   void read_run(const toml::table& t, RunSpec& r) const {
@@ -503,7 +507,8 @@ nlohmann::json scene_to_json(const Scene& s) {
         {"omega", s.initial.omega_B},
         {"velocity_given", s.initial.velocity_given},
         {"velocity", s.initial.velocity},
-        {"omega_along_contact", s.initial.omega_along_contact}}},
+        {"omega_along_contact", s.initial.omega_along_contact},
+        {"height", s.initial.height}}},
       {"run",
        {{"duration", s.run.duration},
         {"sample_interval", s.run.sample_interval},

@@ -1,0 +1,89 @@
+// Side-by-side runs of the reference and engines on one scene, and the metrics that compare them.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "records.h"
+#include "scene.h"
+
+namespace tippe {
+
+// One engine's trajectory as the metrics need it (from a run in memory or a trajectory.csv).
+struct Trajectory {
+  std::vector<double> t, theta, energy, jellett, normal_force, slip_speed, contact_latitude;
+  std::vector<double> x_C, y_C, x_G, y_G;
+  std::vector<int> surface;  // Surface codes
+  static Trajectory from_csv(const CsvTrajectory& csv);
+};
+
+// Metrics of one engine against the reference. Event metrics: an event one side has and the
+// other lacks is a finding: `*_event` says which ("both", "neither", "engine_only",
+// "reference_only") and the errors are then absent (null in JSON).
+struct Metrics {
+  std::string inversion_event, stem_contact_event;
+  std::optional<double> inversion_time_abs_error, inversion_time_rel_error;
+  std::optional<double> stem_contact_time_abs_error, stem_contact_time_rel_error;
+  double tilt_max_error = 0, tilt_rms_error = 0;              // rad, on the common grid
+  double energy_max_error = 0;                                // max |E - E_ref| / E0
+  double energy_final_ratio = 0;                              // E_final / E0 of the engine
+  long long energy_gain_events = 0;                           // dissipative scenes: rises above tolerance
+  double energy_max_gain = 0;                                 // largest rise, / E0
+  double contact_path_rms_error = 0, contact_path_max_error = 0;  // floor contact path, / R
+  double com_path_rms_error = 0, com_path_max_error = 0;          // path of G (x, y), / R
+  double latitude_rms_error = 0;                              // contact latitude on the ball, rad
+  std::optional<double> jellett_drift_ball, jellett_drift_stem;
+  double jellett_max_relative_drift = 0;
+  double wall_seconds = 0, cpu_seconds = 0, real_time_factor = 0;
+  long long steps = 0;
+  double cost_ratio = 0;        // engine CPU seconds / reference CPU seconds
+  double compared_until = 0;    // common grid end (the shorter of the two runs)
+};
+
+// Tolerance for energy gain events: a rise of E between samples above this fraction of E0 in
+// a dissipative scene is energy the integrator injected.
+inline constexpr double kEnergyGainTolerance = 1e-6;
+
+// Pure function of two trajectories and their records (tested on synthetic data).
+Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, const RunRecord& engine,
+                     const Trajectory& engine_traj, const Scene& scene);
+nlohmann::json to_json(const Metrics& m);
+Metrics metrics_from_json(const nlohmann::json& j);
+
+struct CompareOptions {
+  std::vector<std::string> engines = {"bullet", "ode", "mujoco"};
+  int jobs = 1;
+  std::string out_dir;    // where comparison.json, trajectories and reports go ("" = none)
+  std::string cache_dir;  // reference cache ("" = no cache)
+  bool progress = true;   // progress line on stderr
+  bool plots = true;      // render gnuplot SVGs when gnuplot is found
+};
+
+struct EngineResult {
+  RunRecord run;
+  Metrics metrics;
+};
+
+struct Comparison {
+  RunRecord reference;
+  std::vector<EngineResult> engines;
+  nlohmann::json scene;   // scene_to_json
+  Provenance provenance;
+};
+
+// Runs (or loads from the cache) the reference at the scene's tolerances, then every engine,
+// in parallel when jobs > 1; writes the outputs when out_dir is set. An engine that fails to
+// build (bad setting) throws std::invalid_argument before anything runs; an engine that
+// diverges is a result.
+Comparison run_comparison(const Scene& scene, const CompareOptions& options);
+nlohmann::json to_json(const Comparison& c);
+
+// Hash of the physics of a scene (everything but the engine settings and the name): the key of
+// the reference cache.
+std::string physics_hash(const Scene& scene);
+
+}  // namespace tippe
