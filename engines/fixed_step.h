@@ -45,7 +45,7 @@ class FixedStepSimulator : public Simulator {
   virtual ContactReport engine_contacts() const = 0;
   // Adds a lab-frame force at a lab-frame point for the next step only.
   virtual void apply_force_W(const Vec3& f_W, const Vec3& p_W) = 0;
-  // Non-empty when the last step hit an engine limit (e.g. Bullet's angular velocity clamp).
+  // Non-empty when the last step hit an engine limit (e.g. Bullet's pi/4 rotation-per-step clamp).
   virtual std::string engine_limit_hit() const { return {}; }
   // Non-empty when the engine itself failed in the last step (e.g. an ODE internal error).
   virtual std::string engine_failure() const { return {}; }
