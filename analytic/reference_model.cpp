@@ -6,6 +6,7 @@
 #include <boost/numeric/odeint.hpp>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 #include "initial_state.h"
@@ -17,7 +18,42 @@ namespace odeint = boost::numeric::odeint;
 namespace {
 
 using Dopri = odeint::runge_kutta_dopri5<StateVector>;
-using Dense = decltype(odeint::make_dense_output(1.0, 1.0, 1.0, Dopri()));
+using System = std::function<void(const StateVector&, StateVector&, double)>;
+
+// The two dense-output steppers behind one interface, so that the method is a run setting.
+struct DenseStepper {
+  virtual ~DenseStepper() = default;
+  virtual void initialize(const StateVector& y, double t, double dt) = 0;
+  virtual std::pair<double, double> do_step(const System& sys) = 0;
+  virtual void calc_state(double t, StateVector& y) = 0;
+  virtual const StateVector& current_state() const = 0;
+  virtual double current_time() const = 0;
+  virtual double current_time_step() const = 0;
+};
+
+template <class S>
+struct DenseStepperOf final : DenseStepper {
+  explicit DenseStepperOf(S s) : stepper(std::move(s)) {}
+  void initialize(const StateVector& y, double t, double dt) override { stepper.initialize(y, t, dt); }
+  std::pair<double, double> do_step(const System& sys) override { return stepper.do_step(sys); }
+  void calc_state(double t, StateVector& y) override { stepper.calc_state(t, y); }
+  const StateVector& current_state() const override { return stepper.current_state(); }
+  double current_time() const override { return stepper.current_time(); }
+  double current_time_step() const override { return stepper.current_time_step(); }
+  S stepper;
+};
+
+std::unique_ptr<DenseStepper> make_stepper(const RunSpec& run) {
+  const double max_dt = run.duration / 64.0;
+  if (run.method == "dopri5") {
+    auto s = odeint::make_dense_output(run.atol, run.rtol, max_dt, Dopri());
+    return std::make_unique<DenseStepperOf<decltype(s)>>(std::move(s));
+  }
+  // Gragg-Bulirsch-Stoer extrapolation: high and adaptive order, so few, long steps at the
+  // tight tolerances a reference needs; its dense output is a Hermite polynomial of high order.
+  odeint::bulirsch_stoer_dense_out<StateVector> s(run.atol, run.rtol, 1.0, 1.0, max_dt);
+  return std::make_unique<DenseStepperOf<decltype(s)>>(std::move(s));
+}
 
 enum class EvKind { Inversion, Reversion, GrazeLift, GrazePress, NormalForce, SlipReversal, ConeExit, DrillReversal, DrillConeExit, Touchdown };
 struct EvFn {
@@ -47,7 +83,8 @@ struct ReferenceModel::Impl {
   RunSpec run;
   bool flight_allowed;
   ContactMode mode;
-  Dense stepper;
+  std::unique_ptr<DenseStepper> stepper_ptr;
+  DenseStepper& stepper;
   StateVector y_obs{};
   std::vector<EvFn> fns;
   std::vector<double> g_start;
@@ -60,6 +97,7 @@ struct ReferenceModel::Impl {
   double v_eps = 0.0, slip_eps = 0.0;
   double dt_hint = 0.0;
   long long events_in_burst = 0;
+  System system;
   double burst_start = -1.0;
 
   Impl(ReferenceModel& o, const Scene& scene)
@@ -67,7 +105,13 @@ struct ReferenceModel::Impl {
         dyn(BodyModel::from_scene(scene), scene.contact),
         run(scene.run),
         flight_allowed(scene.contact.flight),
-        stepper(odeint::make_dense_output(scene.run.atol, scene.run.rtol, scene.run.duration / 64.0, Dopri())) {}
+        stepper_ptr(make_stepper(scene.run)),
+        stepper(*stepper_ptr) {
+    system = [this](const StateVector& y, StateVector& dy, double) {
+      ++owner.rhs_evals_;
+      dyn.evaluate(y, mode, &dy);
+    };
+  }
 
   ContactForces forces_at(const StateVector& y, const ContactMode& m) {
     ++owner.rhs_evals_;
@@ -199,25 +243,36 @@ struct ReferenceModel::Impl {
         ++owner.rhs_evals_;
       }
     }
-    const auto [t0, t1] = stepper.do_step([this](const StateVector& y, StateVector& dy, double) {
-      ++owner.rhs_evals_;
-      dyn.evaluate(y, mode, &dy);
-    });
+    const auto [t0, t1] = stepper.do_step(system);
     ++owner.steps_;
     dt_hint = stepper.current_time_step();
-    const double tm = 0.5 * (t0 + t1);
-    StateVector ym;
-    stepper.calc_state(tm, ym);
     const StateVector y1 = stepper.current_state();
-    const std::vector<double> gm = g_all(ym), g1 = g_all(y1);
+    // Event functions are checked at interior points of the step too: a long high-order step
+    // can hold a dip of F_n below zero and back, or several nutation periods. At least 2 checks,
+    // and one per 1/64 of a rotation period 2 pi / |w| (the dip of F_n to loss of contact on the
+    // reference's spin-20 top lasts about 1/20 of a period).
+    const double w = unpack(y1, t1).w_B.norm();
+    const int n_checks = std::clamp(static_cast<int>(std::ceil((t1 - t0) * w * 64.0 / (2 * M_PI))), 2, 1024);
+    std::vector<double> t_chk(n_checks + 1);
+    std::vector<std::vector<double>> g_chk(n_checks + 1);
+    t_chk[0] = t0;
+    g_chk[0] = g_start;
+    for (int k = 1; k <= n_checks; ++k) {
+      t_chk[k] = k == n_checks ? t1 : t0 + (t1 - t0) * k / n_checks;
+      StateVector yk;
+      if (k == n_checks) yk = y1;
+      else stepper.calc_state(t_chk[k], yk);
+      g_chk[k] = g_all(yk);
+    }
+    const std::vector<double>& g1 = g_chk[n_checks];
     double best_t = t1 + 1.0;
     int best = -1;
     std::vector<std::pair<double, int>> found;
     for (size_t i = 0; i < fns.size(); ++i) {
-      double te;
-      if (g_start[i] > 0 && gm[i] <= 0) te = locate(fns[i], t0, tm, g_start[i], gm[i]);
-      else if (gm[i] > 0 && g1[i] <= 0) te = locate(fns[i], tm, t1, gm[i], g1[i]);
-      else continue;
+      int k = 1;
+      while (k <= n_checks && !(g_chk[k - 1][i] > 0 && g_chk[k][i] <= 0)) ++k;
+      if (k > n_checks) continue;
+      const double te = locate(fns[i], t_chk[k - 1], t_chk[k], g_chk[k - 1][i], g_chk[k][i]);
       found.emplace_back(te, static_cast<int>(i));
       const bool records_only = fns[i].kind == EvKind::Inversion || fns[i].kind == EvKind::Reversion;
       if (!records_only && te < best_t) {

@@ -60,6 +60,9 @@ struct RunSpec {
   double sample_interval = 1e-3;
   double rtol = 1e-10;
   double atol = 1e-12;
+  // Reference integrator: "bulirsch_stoer" (extrapolation, high order: the default) or "dopri5"
+  // (Dormand-Prince 5(4)); both with dense output for event location.
+  std::string method = "bulirsch_stoer";
 };
 
 // One value of an engine setting as written in a scene or on the command line.

@@ -24,7 +24,7 @@ class AnalyticSimulator final : public Simulator {
   std::string engine() const override { return "analytic"; }
   std::string version() const override {
     return "reference (Boost.Odeint " + std::to_string(BOOST_VERSION / 100000) + "." +
-           std::to_string(BOOST_VERSION / 100 % 1000) + " dopri5)";
+           std::to_string(BOOST_VERSION / 100 % 1000) + ")";
   }
   void advance_to(double t) override {
     WorkTimer timer(work_.wall_seconds, work_.cpu_seconds);
@@ -69,7 +69,7 @@ class AnalyticSimulator final : public Simulator {
     return out;
   }
   SettingsList settings() const override {
-    return {{"method", "runge_kutta_dopri5 (dense output)"},
+    return {{"method", scene_.run.method},
             {"rtol", num(scene_.run.rtol)},
             {"atol", num(scene_.run.atol)},
             {"event_location", "TOMS 748 on dense output"}};

@@ -383,7 +383,7 @@ class Interpreter {
   }
 
   void read_run(const toml::table& t, RunSpec& r) const {
-    keys(t, "run", {"duration", "sample_interval", "rtol", "atol"});
+    keys(t, "run", {"duration", "sample_interval", "rtol", "atol", "method"});
     r.duration = need_positive(t, "run", "duration");
     r.sample_interval = need_positive(t, "run", "sample_interval");
     if (r.sample_interval > r.duration)
@@ -395,6 +395,13 @@ class Interpreter {
     if (!(r.rtol > 0 && r.rtol <= 1e-2)) fail("run.rtol", "must lie in (0, 1e-2], got " + num(r.rtol));
     r.atol = opt_number(t, "run", "atol").value_or(r.atol);
     if (!(r.atol > 0 && r.atol <= 1)) fail("run.atol", "must lie in (0, 1], got " + num(r.atol));
+    if (const toml::node* m = t.get("method")) {
+      const auto* str = m->as_string();
+      if (!str) fail("run.method", "expected a string");
+      r.method = str->get();
+      if (r.method != "bulirsch_stoer" && r.method != "dopri5")
+        fail("run.method", "must be \"bulirsch_stoer\" or \"dopri5\", got \"" + r.method + "\"");
+    }
   }
 
   SettingValue to_setting(const toml::node& n, const std::string& path) const {
@@ -513,7 +520,8 @@ nlohmann::json scene_to_json(const Scene& s) {
        {{"duration", s.run.duration},
         {"sample_interval", s.run.sample_interval},
         {"rtol", s.run.rtol},
-        {"atol", s.run.atol}}},
+        {"atol", s.run.atol},
+        {"method", s.run.method}}},
       {"engines", engines},
   };
 }
