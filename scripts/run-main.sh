@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# The main job: install, build, and compare every engine with the reference on the default scene.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/build.sh
+scene="${1:-harness/scenes/source_dimensionless.toml}"
+./build/tippe compare "$scene" --jobs "$(nproc)"
