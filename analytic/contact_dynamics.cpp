@@ -158,9 +158,15 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
       for (int j = 0; j < n; ++j)
         K(i, j) = rows[i].f.dot(cols[j].f) / m_.M + rows[i].tau.dot(Iinv_W * cols[j].tau);
     }
-    const auto lu = K.fullPivLu();
-    out.solvable = lu.isInvertible();
-    u = lu.solve(b);
+    if (n == 1) {
+      // One sliding or frictionless contact: the common case of a run, solved directly.
+      out.solvable = K(0, 0) != 0.0;
+      u(0) = b(0) / K(0, 0);
+    } else {
+      const auto lu = K.fullPivLu();
+      out.solvable = lu.isInvertible();
+      u = lu.solve(b);
+    }
   }
 
   Vec3 F = F_known, T = T_known;

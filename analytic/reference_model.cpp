@@ -251,19 +251,31 @@ struct ReferenceModel::Impl {
     // can hold a dip of F_n below zero and back, or several nutation periods. At least 2 checks,
     // and one per 1/64 of a rotation period 2 pi / |w| (the dip of F_n to loss of contact on the
     // reference's spin-20 top lasts about 1/20 of a period).
+    // Coarse checks (8 per period) first; the fine ones only where a normal force comes within
+    // 30 % of M g of zero, so a top far from lifting off pays for few checks.
     const double w = unpack(y1, t1).w_B.norm();
-    const int n_checks = std::clamp(static_cast<int>(std::ceil((t1 - t0) * w * 64.0 / (2 * M_PI))), 2, 1024);
-    std::vector<double> t_chk(n_checks + 1);
-    std::vector<std::vector<double>> g_chk(n_checks + 1);
-    t_chk[0] = t0;
-    g_chk[0] = g_start;
-    for (int k = 1; k <= n_checks; ++k) {
-      t_chk[k] = k == n_checks ? t1 : t0 + (t1 - t0) * k / n_checks;
-      StateVector yk;
-      if (k == n_checks) yk = y1;
-      else stepper.calc_state(t_chk[k], yk);
-      g_chk[k] = g_all(yk);
-    }
+    const double periods = (t1 - t0) * w / (2 * M_PI);
+    std::vector<double> t_chk;
+    std::vector<std::vector<double>> g_chk;
+    auto sample = [&](int n_checks) {
+      t_chk.assign(n_checks + 1, t0);
+      g_chk.assign(n_checks + 1, g_start);
+      for (int k = 1; k <= n_checks; ++k) {
+        t_chk[k] = k == n_checks ? t1 : t0 + (t1 - t0) * k / n_checks;
+        StateVector yk;
+        if (k == n_checks) yk = y1;
+        else stepper.calc_state(t_chk[k], yk);
+        g_chk[k] = g_all(yk);
+      }
+    };
+    sample(std::clamp(static_cast<int>(std::ceil(periods * 8.0)), 2, 1024));
+    const double load = dyn.body().M * dyn.body().g;
+    bool near_lift = false;
+    for (size_t i = 0; i < fns.size(); ++i)
+      if (fns[i].kind == EvKind::NormalForce)
+        for (const auto& gk : g_chk) near_lift = near_lift || gk[i] < 0.3 * load;
+    if (near_lift) sample(std::clamp(static_cast<int>(std::ceil(periods * 64.0)), 2, 1024));
+    const int n_checks = static_cast<int>(t_chk.size()) - 1;
     const std::vector<double>& g1 = g_chk[n_checks];
     double best_t = t1 + 1.0;
     int best = -1;

@@ -35,6 +35,12 @@ class FixedStepSimulator : public Simulator {
   std::string status_detail() const override { return status_detail_; }
   std::vector<Event> events() const override { return events_; }
 
+  // Benchmarks only: n engine steps with none of the adapter's work (no events, checks,
+  // observations or viscous forces), to measure the adapter's overhead against the bare engine.
+  void bare_steps(long long n) {
+    for (long long i = 0; i < n; ++i) engine_step();
+  }
+
  protected:
   explicit FixedStepSimulator(const Scene& scene);
   // Must be called by the derived constructor once the engine is built.
