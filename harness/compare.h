@@ -19,6 +19,20 @@ struct Trajectory {
   std::vector<double> x_C, y_C, x_G, y_G;
   std::vector<int> surface;  // Surface codes
   static Trajectory from_csv(const CsvTrajectory& csv);
+  void append(const Observation& o);
+  size_t size() const { return t.size(); }
+};
+
+// Keeps the sampled columns of a run in memory while passing every sample on to `next` (e.g.
+// a CsvTrajectoryWriter), so one run yields both the metrics' input and the file.
+class TrajectorySink : public SampleSink {
+ public:
+  explicit TrajectorySink(std::vector<SampleSink*> next = {}) : next_(std::move(next)) {}
+  void write(const Observation& o) override;
+  Trajectory trajectory;
+
+ private:
+  std::vector<SampleSink*> next_;
 };
 
 // Metrics of one engine against the reference. Event metrics: an event one side has and the
@@ -48,7 +62,15 @@ struct Metrics {
 // a dissipative scene is energy the integrator injected.
 inline constexpr double kEnergyGainTolerance = 1e-6;
 
-// Pure function of two trajectories and their records (tested on synthetic data).
+// Whether the scene's contact law removes energy (viscous k > 0, Coulomb mu > 0, or drilling
+// friction), so that any rise of E between samples is an integrator artefact.
+bool energy_must_not_rise(const Scene& scene);
+
+// Pure function of two trajectories and their records (tested on synthetic data). The common
+// grid: samples matched by index up to the shorter run when every pair of times agrees within
+// half a sample interval, else the engine interpolated linearly onto the reference's times.
+// Pairs where either value is not finite are left out of the error sums. With no common sample
+// the error metrics are NaN (null in JSON).
 Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, const RunRecord& engine,
                      const Trajectory& engine_traj, const Scene& scene);
 nlohmann::json to_json(const Metrics& m);
@@ -73,17 +95,31 @@ struct Comparison {
   std::vector<EngineResult> engines;
   nlohmann::json scene;   // scene_to_json
   Provenance provenance;
+  bool reference_cached = false;  // the reference came from the cache, not from this run
 };
 
 // Runs (or loads from the cache) the reference at the scene's tolerances, then every engine,
 // in parallel when jobs > 1; writes the outputs when out_dir is set. An engine that fails to
 // build (bad setting) throws std::invalid_argument before anything runs; an engine that
 // diverges is a result.
+// Invalid input (unknown or repeated engine, jobs < 1, a bad [engines.NAME] setting) throws
+// before any file is written. A cache entry is used only when its summary has the same physics
+// hash, git commit and reference version as this build; otherwise it is re-run and replaced.
 Comparison run_comparison(const Scene& scene, const CompareOptions& options);
+// comparison.json: {"format", "scene_name", "scene_file", "scene_hash", "physics_hash", "scene",
+// "provenance" (with "engine_versions"), "reference": {"cached", "summary"}, "engines":
+// [{"engine", "summary", "metrics"}, ...]}; summaries are to_json(RunRecord), except that only
+// the first kMaxSwitchEventsKept "switch" events are listed and the rest counted in
+// "events_omitted": {"switch": N}.
+inline constexpr long long kMaxSwitchEventsKept = 100;
 nlohmann::json to_json(const Comparison& c);
+// Throws nlohmann::json::exception for a missing or mistyped field.
+Comparison comparison_from_json(const nlohmann::json& j);
 
 // Hash of the physics of a scene (everything but the engine settings and the name): the key of
 // the reference cache.
 std::string physics_hash(const Scene& scene);
+// The same over a scene_to_json document (e.g. a record's scene_spec).
+std::string physics_hash(const nlohmann::json& scene_json);
 
 }  // namespace tippe

@@ -1,0 +1,56 @@
+// Comparison reports from records alone: Markdown for terminals and CI logs, a self-contained HTML page, gnuplot SVG plots.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace tippe {
+
+// Every function here reads a comparison.json document (to_json(Comparison)). An optional
+// top-level "tolerances" object colours metric cells in the HTML: {"METRIC": {"green": a,
+// "amber": b}} makes a value below a green, below b amber, else red (METRIC a key of the
+// metrics, e.g. "tilt_rms_error"). Relative event-time errors default to green below 1 %,
+// amber below 10 %; an event the reference has and the engine lacks (or the reverse) is red.
+
+// The summary table in Markdown: the reference, then one row per engine.
+std::string render_summary_table(const nlohmann::json& comparison);
+// Plain sentences: an event one side has and the other lacks, energy gain events, runs whose
+// status is not ok (with time and detail). Empty when there is nothing to say.
+std::vector<std::string> report_findings(const nlohmann::json& comparison);
+// One line on who inverts: "reference: inverts at t = 17.25 | ode: inverts at t = 17.28 (+0.14 %) |
+// bullet: no inversion (diverged at t = 3.2)"; for indexes of many reports.
+std::string render_summary_line(const nlohmann::json& comparison);
+// report.md: scene, summary table, findings, provenance footer.
+std::string render_markdown(const nlohmann::json& comparison);
+// index.html, self-contained (inline CSS, no scripts, no network). plot_files: SVG names
+// relative to the page, shown in order with captions; plots_note: said where the plots go
+// (e.g. "plots skipped: gnuplot not found"), or below them when some are missing.
+std::string render_html(const nlohmann::json& comparison, const std::vector<std::string>& plot_files,
+                        const std::string& plots_note = "");
+
+// The SVGs render_plots makes, in page order, and their captions.
+const std::vector<std::string>& plot_file_names();
+std::string plot_caption(const std::string& file);
+
+// The command that runs gnuplot: $TIPPE_GNUPLOT when set ("none" disables plots), else gnuplot
+// found on PATH. Empty when there is none; `why_not` then says why, as the page should.
+std::string gnuplot_command(std::string* why_not = nullptr);
+
+struct PlotSet {
+  std::vector<std::string> files;  // non-empty SVGs written, relative to out_dir
+  std::string note;                // "" when every plot was made
+};
+// Writes plots.gp and decimated plot-*.dat files into out_dir from reference.csv and
+// ENGINE.csv there, and runs gnuplot on them. Never throws for a missing gnuplot or trajectory:
+// the note says what is missing.
+PlotSet render_plots(const std::string& out_dir, const nlohmann::json& comparison);
+
+// report.md, index.html and (when `plots`) the SVGs in out_dir, from `comparison` and the
+// trajectories beside it; so `tippe report DIR` can regenerate a report from records alone.
+void write_report(const std::string& out_dir, const nlohmann::json& comparison, bool plots);
+
+std::string html_escape(const std::string& text);
+
+}  // namespace tippe
