@@ -65,7 +65,12 @@ class FixedStepSimulator : public Simulator {
 
  private:
   void step_once();
-  void track_events(const Observation& before, const Observation& after);
+  // What the per-step checks keep of a step's end.
+  struct StepProbe {
+    BodyState state;
+    double cos_theta = 1.0, gap_ball = 0.0, gap_stem = 0.0;
+  };
+  void track_events(const StepProbe& before, const StepProbe& after);
   void fail(RunStatus s, double t, const std::string& why);
 
   Scene scene_;
@@ -79,7 +84,7 @@ class FixedStepSimulator : public Simulator {
   std::string status_detail_;
   std::vector<Event> events_;
   WorkCounters work_;
-  Observation last_;
+  StepProbe last_;
   bool inverted_ = false, stem_touched_ = false;
   Surface contact_surface_ = Surface::None;
 };
