@@ -1,0 +1,1098 @@
+// Work-precision sweeps: reading sweep files into checked plans, the records.jsonl format, and resumable parallel runs.
+#include "sweep.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <toml++/toml.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <initializer_list>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "provenance.h"
+#include "records.h"
+#include "scene_io.h"
+#include "timing.h"
+
+namespace tippe {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr int kMaxRepeats = 100;
+
+const char* type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::none:
+      return "nothing";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a float";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::date:
+      return "a date";
+    case toml::node_type::time:
+      return "a time";
+    case toml::node_type::date_time:
+      return "a date-time";
+  }
+  return "?";
+}
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(12);
+  os << v;
+  return os.str();
+}
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return {};
+  const auto e = s.find_last_not_of(" \t");
+  return s.substr(b, e - b + 1);
+}
+
+bool is_name(const std::string& n) {
+  return !n.empty() && n != "." && n != ".." && std::all_of(n.begin(), n.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+           c == '.';
+  });
+}
+
+std::string idx(const std::string& key, size_t i) { return key + "[" + std::to_string(i) + "]"; }
+
+std::string read_bytes(const std::string& path, const std::function<void(const std::string&)>& fail) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) fail("is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(std::strerror(errno));
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (in.bad()) fail(std::strerror(errno));
+  return bytes.str();
+}
+
+// Checks one sweep file; every message names the file and the dotted key.
+class SweepReader {
+ public:
+  explicit SweepReader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& why) const {
+    throw SceneError(file_ + ": " + key + ": " + why);
+  }
+
+  void keys(const toml::table& t, const std::string& prefix, std::initializer_list<const char*> allowed) const {
+    for (auto&& [k, v] : t) {
+      (void)v;
+      const std::string key(k.str());
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+        std::string list;
+        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        fail(prefix.empty() ? key : prefix + "." + key, "unknown key (expected one of: " + list + ")");
+      }
+    }
+  }
+
+  double number(const toml::node& n, const std::string& key) const {
+    double v;
+    if (const auto* f = n.as_floating_point())
+      v = f->get();
+    else if (const auto* i = n.as_integer())
+      v = static_cast<double>(i->get());
+    else
+      fail(key, std::string("expected a number, got ") + type_name(n));
+    if (!std::isfinite(v)) fail(key, "must be a finite number, got " + num(v));
+    return v;
+  }
+
+  std::string string(const toml::node& n, const std::string& key) const {
+    const auto* s = n.as_string();
+    if (!s) fail(key, std::string("expected a string, got ") + type_name(n));
+    return s->get();
+  }
+
+  const toml::array& array(const toml::node& n, const std::string& key) const {
+    const auto* a = n.as_array();
+    if (!a) fail(key, std::string("expected an array, got ") + type_name(n));
+    return *a;
+  }
+
+  const toml::table& table(const toml::node& n, const std::string& key) const {
+    const auto* t = n.as_table();
+    if (!t) fail(key, std::string("expected a table, got ") + type_name(n));
+    return *t;
+  }
+
+  // A ladder value as the TOML text an override needs: integers stay integers (iteration
+  // counts), floats keep the shortest text that reads back to the same double.
+  std::string value_text(const toml::node& n, const std::string& key, double& value) const {
+    value = number(n, key);
+    if (const auto* i = n.as_integer()) return std::to_string(i->get());
+    return json(value).dump();
+  }
+
+  SweepSpec read(const toml::table& root, const std::string& text) const {
+    SweepSpec s;
+    s.file = file_;
+    s.text = text;
+    s.hash = fnv1a_hex({text});
+    keys(root, "", {"description", "repeats", "duration", "scenes", "setup"});
+    if (const toml::node* d = root.get("description")) {
+      s.description = string(*d, "description");
+      if (s.description.find_first_of("\r\n") != std::string::npos) fail("description", "must be one line");
+    }
+    if (const toml::node* r = root.get("repeats")) {
+      const auto* i = r->as_integer();
+      if (!i) fail("repeats", std::string("expected an integer, got ") + type_name(*r));
+      if (i->get() < 1 || i->get() > kMaxRepeats)
+        fail("repeats", "must lie in [1, " + std::to_string(kMaxRepeats) + "], got " + std::to_string(i->get()));
+      s.repeats = static_cast<int>(i->get());
+    }
+    if (const toml::node* d = root.get("duration")) {
+      s.duration = number(*d, "duration");
+      if (!(*s.duration > 0)) fail("duration", "must be > 0, got " + num(*s.duration));
+    }
+
+    const toml::node* sc = root.get("scenes");
+    if (!sc) fail("scenes", "missing (required: an array of scene files)");
+    const toml::array& scenes = array(*sc, "scenes");
+    if (scenes.empty()) fail("scenes", "must list at least one scene");
+    const fs::path base = fs::path(file_).parent_path();
+    for (size_t i = 0; i < scenes.size(); ++i) {
+      const std::string key = idx("scenes", i);
+      SweepScene e;
+      const toml::node& n = *scenes.get(i);
+      if (n.is_string()) {
+        e.file = string(n, key);
+      } else if (const auto* t = n.as_table()) {
+        keys(*t, key, {"file", "duration"});
+        const toml::node* f = t->get("file");
+        if (!f) fail(key + ".file", "missing (required)");
+        e.file = string(*f, key + ".file");
+        if (const toml::node* d = t->get("duration")) {
+          e.duration = number(*d, key + ".duration");
+          if (!(*e.duration > 0)) fail(key + ".duration", "must be > 0, got " + num(*e.duration));
+        }
+      } else {
+        fail(key, std::string("expected a file name or a table {file, duration}, got ") + type_name(n));
+      }
+      if (e.file.empty()) fail(key, "empty file name");
+      e.path = (fs::path(e.file).is_absolute() ? fs::path(e.file) : base / e.file).lexically_normal().string();
+      s.scenes.push_back(e);
+    }
+
+    const toml::node* su = root.get("setup");
+    if (!su) fail("setup", "missing (required: one or more [[setup]] tables)");
+    const toml::array& setups = array(*su, "setup");
+    if (setups.empty()) fail("setup", "must have at least one [[setup]]");
+    const std::vector<std::string> engines = available_engines();
+    std::map<std::string, size_t> names;
+    for (size_t i = 0; i < setups.size(); ++i) {
+      const std::string key = idx("setup", i);
+      const toml::table& t = table(*setups.get(i), key);
+      keys(t, key, {"name", "engine", "set", "ladder"});
+      SweepSetup u;
+      const toml::node* name = t.get("name");
+      if (!name) fail(key + ".name", "missing (required)");
+      u.name = string(*name, key + ".name");
+      if (!is_name(u.name))
+        fail(key + ".name", "\"" + u.name + "\" is not a usable name (letters, digits, '.', '_', '-')");
+      if (auto [it, fresh] = names.emplace(u.name, i); !fresh)
+        fail(key + ".name", "\"" + u.name + "\" is already the name of " + idx("setup", it->second));
+      const toml::node* engine = t.get("engine");
+      if (!engine) fail(key + ".engine", "missing (required)");
+      u.engine = string(*engine, key + ".engine");
+      if (std::find(engines.begin(), engines.end(), u.engine) == engines.end()) {
+        std::string list;
+        for (const auto& e : engines) list += (list.empty() ? "" : ", ") + e;
+        fail(key + ".engine", "unknown engine \"" + u.engine + "\" (expected one of: " + list + ")");
+      }
+      std::set<std::string> set_keys;
+      if (const toml::node* set = t.get("set")) {
+        const toml::array& a = array(*set, key + ".set");
+        for (size_t j = 0; j < a.size(); ++j) {
+          const std::string sk = idx(key + ".set", j);
+          const std::string o = string(*a.get(j), sk);
+          const auto eq = o.find('=');
+          if (eq == std::string::npos || trim(o.substr(0, eq)).empty())
+            fail(sk, "malformed override \"" + o + "\" (expected KEY=VALUE)");
+          const std::string k = trim(o.substr(0, eq));
+          check_setting_key(u.engine, k, sk);
+          if (!set_keys.insert(k).second) fail(sk, k + " is set twice");
+          u.set.push_back(o);
+        }
+      }
+      const toml::node* ladder = t.get("ladder");
+      if (!ladder) fail(key + ".ladder", "missing (required: {key = \"...\", values = [...]})");
+      const toml::table& l = table(*ladder, key + ".ladder");
+      keys(l, key + ".ladder", {"key", "values"});
+      const toml::node* lk = l.get("key");
+      if (!lk) fail(key + ".ladder.key", "missing (required)");
+      u.ladder_key = trim(string(*lk, key + ".ladder.key"));
+      check_setting_key(u.engine, u.ladder_key, key + ".ladder.key");
+      if (set_keys.count(u.ladder_key)) fail(key + ".ladder.key", u.ladder_key + " is also fixed in " + key + ".set");
+      const toml::node* lv = l.get("values");
+      if (!lv) fail(key + ".ladder.values", "missing (required)");
+      const toml::array& values = array(*lv, key + ".ladder.values");
+      if (values.empty()) fail(key + ".ladder.values", "must list at least one value");
+      for (size_t j = 0; j < values.size(); ++j) {
+        const std::string vk = idx(key + ".ladder.values", j);
+        double v;
+        const std::string vt = value_text(*values.get(j), vk, v);
+        for (size_t m = 0; m < u.ladder_values.size(); ++m)
+          if (u.ladder_values[m] == v) fail(vk, num(v) + " repeats " + idx(key + ".ladder.values", m));
+        u.ladder_values.push_back(v);
+        u.ladder_texts.push_back(vt);
+      }
+      s.setups.push_back(u);
+    }
+    return s;
+  }
+
+ private:
+  // A sweep compares settings of one engine on fixed physics; a setup that could change the
+  // scene itself would make its errors mean nothing.
+  void check_setting_key(const std::string& engine, const std::string& k, const std::string& where) const {
+    if (engine == "analytic") {
+      if (k != "run.rtol" && k != "run.atol" && k != "run.method")
+        fail(where, "\"" + k +
+                        "\" is not a setting of the analytic model (run.rtol, run.atol, run.method); a sweep "
+                        "never changes the physics");
+    } else if (k.rfind("engines." + engine + ".", 0) != 0 || k.size() == engine.size() + 9) {
+      fail(where, "\"" + k + "\" is not a setting of " + engine + " (expected engines." + engine +
+                      ".KEY); a sweep never changes the physics");
+    }
+  }
+
+  std::string file_;
+};
+
+// The scene's own message without its "FILE: " prefix, with the file named at the end.
+std::string quote_scene_error(const SceneError& e, const std::string& scene_path) {
+  std::string msg = e.what();
+  const std::string prefix = scene_path + ": ";
+  if (msg.rfind(prefix, 0) == 0) msg = msg.substr(prefix.size()) + " (scene " + scene_path + ")";
+  return msg;
+}
+
+// Which override a scene error is about: the key the scene names, matched against "KEY=VALUE".
+std::optional<size_t> override_named(const SceneError& e, const std::string& scene_path,
+                                     const std::vector<std::string>& set) {
+  std::string msg = e.what();
+  const std::string prefix = scene_path + ": ";
+  if (msg.rfind(prefix, 0) != 0) return std::nullopt;
+  msg = msg.substr(prefix.size());
+  const std::string key = msg.substr(0, msg.find(": "));
+  for (size_t j = 0; j < set.size(); ++j)
+    if (trim(set[j].substr(0, set[j].find('='))) == key) return j;
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::string fnv1a_hex(const std::vector<std::string>& parts) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  auto feed = [&h](unsigned char c) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  };
+  for (const auto& p : parts) {
+    for (unsigned char c : p) feed(c);
+    feed(0);
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& setup, const std::string& value_text,
+                           int repeats) {
+  std::vector<std::string> parts = {"tippe-sweep-point-1", physics_hash, setup.name, setup.engine};
+  parts.push_back(std::to_string(setup.set.size()));
+  for (const auto& s : setup.set) parts.push_back(s);
+  parts.push_back(setup.ladder_key);
+  parts.push_back(value_text);
+  parts.push_back(std::to_string(repeats));
+  return fnv1a_hex(parts);
+}
+
+SweepPlan load_sweep(const std::string& path) {
+  SweepReader reader(path);
+  const std::string text =
+      read_bytes(path, [&](const std::string& why) { throw SceneError(path + ": cannot read: " + why); });
+  toml::table root;
+  try {
+    root = toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    throw SceneError(path + ":" + std::to_string(e.source().begin.line) + ":" +
+                     std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
+  }
+  SweepPlan plan;
+  plan.spec = reader.read(root, text);
+  const SweepSpec& s = plan.spec;
+
+  std::map<std::string, size_t> scene_names;
+  std::vector<std::vector<std::string>> scene_overrides;
+  for (size_t i = 0; i < s.scenes.size(); ++i) {
+    const SweepScene& e = s.scenes[i];
+    const std::string key = idx("scenes", i);
+    std::vector<std::string> over;
+    const std::optional<double> duration = e.duration ? e.duration : s.duration;
+    if (duration) over.push_back("run.duration=" + json(*duration).dump());
+    Scene scene;
+    try {
+      scene = load_scene(e.path);
+    } catch (const SceneError& x) {
+      reader.fail(key, quote_scene_error(x, e.path));
+    }
+    if (!over.empty()) {
+      try {
+        scene = load_scene(e.path, over);
+      } catch (const SceneError& x) {
+        reader.fail(e.duration ? key + ".duration" : std::string("duration"), quote_scene_error(x, e.path));
+      }
+    }
+    if (auto [it, fresh] = scene_names.emplace(scene.name, i); !fresh)
+      reader.fail(key, "scene \"" + scene.name + "\" is already listed as " + idx("scenes", it->second));
+    plan.physics_hashes.push_back(physics_hash(scene));
+    plan.scenes.push_back(std::move(scene));
+    scene_overrides.push_back(over);
+  }
+
+  std::vector<std::string> ids;
+  for (size_t i = 0; i < s.scenes.size(); ++i) {
+    const std::string& file = s.scenes[i].path;
+    for (size_t u = 0; u < s.setups.size(); ++u) {
+      const SweepSetup& setup = s.setups[u];
+      const std::string key = idx("setup", u);
+      std::vector<std::string> over = scene_overrides[i];
+      over.insert(over.end(), setup.set.begin(), setup.set.end());
+      try {
+        load_scene(file, over);
+      } catch (const SceneError& x) {
+        const auto j = override_named(x, file, setup.set);
+        reader.fail(j ? idx(key + ".set", *j) : key + ".set", quote_scene_error(x, file));
+      }
+      for (size_t k = 0; k < setup.ladder_values.size(); ++k) {
+        std::vector<std::string> point_over = over;
+        point_over.push_back(setup.ladder_key + "=" + setup.ladder_texts[k]);
+        SweepPoint p;
+        p.scene_index = i;
+        p.setup_index = u;
+        p.ladder_index = k;
+        try {
+          p.scene = load_scene(file, point_over);
+        } catch (const SceneError& x) {
+          reader.fail(idx(key + ".ladder.values", k), quote_scene_error(x, file));
+        }
+        p.id = sweep_point_id(plan.physics_hashes[i], setup, setup.ladder_texts[k], s.repeats);
+        ids.push_back(p.id);
+        plan.points.push_back(std::move(p));
+      }
+    }
+  }
+  plan.plan_hash = fnv1a_hex(ids);
+  return plan;
+}
+
+// ---- records ----------------------------------------------------------------------------------
+
+namespace {
+
+json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json number(const std::optional<double>& v) { return v ? number(*v) : json(nullptr); }
+double get_number(const json& j, const char* key) {
+  const json& v = j.at(key);
+  return v.is_null() ? std::nan("") : v.get<double>();
+}
+std::optional<double> get_optional(const json& j, const char* key) {
+  const json& v = j.at(key);
+  if (v.is_null()) return std::nullopt;
+  return v.get<double>();
+}
+
+}  // namespace
+
+json to_json(const SweepRecord& r) {
+  json cpu = json::array();
+  for (double c : r.cpu_seconds_repeats) cpu.push_back(number(c));
+  return json{
+      {"format", "tippe-sweep-record-1"},
+      {"point_id", r.point_id},
+      {"scene", r.scene},
+      {"scene_file", r.scene_file},
+      {"physics_hash", r.physics_hash},
+      {"scene_index", r.scene_index},
+      {"setup", r.setup},
+      {"engine", r.engine},
+      {"set", r.set},
+      {"ladder_key", r.ladder_key},
+      {"ladder_value", number(r.ladder_value)},
+      {"setup_index", r.setup_index},
+      {"ladder_index", r.ladder_index},
+      {"repeats", r.repeats},
+      {"duration", number(r.duration)},
+      {"status", r.status},
+      {"status_time", number(r.status_time)},
+      {"status_detail", r.status_detail},
+      {"inversion_time", number(r.inversion_time)},
+      {"stem_contact_time", number(r.stem_contact_time)},
+      {"reference_inversion_time", number(r.reference_inversion_time)},
+      {"reference_stem_contact_time", number(r.reference_stem_contact_time)},
+      {"metrics", to_json(r.metrics)},
+      {"work",
+       {{"cpu_seconds", number(r.cpu_seconds)},
+        {"cpu_seconds_repeats", cpu},
+        {"wall_seconds", number(r.wall_seconds)},
+        {"steps", r.steps},
+        {"rhs_evaluations", r.rhs_evaluations},
+        {"solver_iterations", r.solver_iterations}}},
+      {"engine_version", r.engine_version},
+      {"git_commit", r.git_commit},
+      {"settings", r.settings},
+  };
+}
+
+SweepRecord sweep_record_from_json(const json& j) {
+  if (j.at("format").get<std::string>() != "tippe-sweep-record-1")
+    throw std::invalid_argument("unknown record format \"" + j.at("format").get<std::string>() + "\"");
+  SweepRecord r;
+  r.point_id = j.at("point_id").get<std::string>();
+  r.scene = j.at("scene").get<std::string>();
+  r.scene_file = j.at("scene_file").get<std::string>();
+  r.physics_hash = j.at("physics_hash").get<std::string>();
+  r.scene_index = j.at("scene_index").get<long long>();
+  r.setup = j.at("setup").get<std::string>();
+  r.engine = j.at("engine").get<std::string>();
+  r.set = j.at("set").get<std::vector<std::string>>();
+  r.ladder_key = j.at("ladder_key").get<std::string>();
+  r.ladder_value = get_number(j, "ladder_value");
+  r.setup_index = j.at("setup_index").get<long long>();
+  r.ladder_index = j.at("ladder_index").get<long long>();
+  r.repeats = j.at("repeats").get<long long>();
+  r.duration = get_number(j, "duration");
+  r.status = j.at("status").get<std::string>();
+  r.status_time = get_number(j, "status_time");
+  r.status_detail = j.at("status_detail").get<std::string>();
+  r.inversion_time = get_optional(j, "inversion_time");
+  r.stem_contact_time = get_optional(j, "stem_contact_time");
+  r.reference_inversion_time = get_optional(j, "reference_inversion_time");
+  r.reference_stem_contact_time = get_optional(j, "reference_stem_contact_time");
+  r.metrics = metrics_from_json(j.at("metrics"));
+  const json& w = j.at("work");
+  r.cpu_seconds = get_number(w, "cpu_seconds");
+  for (const json& c : w.at("cpu_seconds_repeats"))
+    r.cpu_seconds_repeats.push_back(c.is_null() ? std::nan("") : c.get<double>());
+  r.wall_seconds = get_number(w, "wall_seconds");
+  r.steps = w.at("steps").get<long long>();
+  r.rhs_evaluations = w.at("rhs_evaluations").get<long long>();
+  r.solver_iterations = w.at("solver_iterations").get<long long>();
+  r.engine_version = j.at("engine_version").get<std::string>();
+  r.git_commit = j.at("git_commit").get<std::string>();
+  r.settings = j.at("settings");
+  if (!r.settings.is_object()) throw std::invalid_argument("settings: expected an object");
+  return r;
+}
+
+// An engine's status detail is not guaranteed UTF-8; a replacement character beats losing the point.
+std::string to_jsonl(const SweepRecord& r) {
+  return to_json(r).dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
+}
+
+size_t complete_lines_length(const std::string& text) {
+  const auto last = text.rfind('\n');
+  return last == std::string::npos ? 0 : last + 1;
+}
+
+RecordsFile read_records(const std::string& path) {
+  RecordsFile f;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) return f;
+    throw std::runtime_error(path + ": cannot read: " + std::strerror(errno));
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  f.complete_bytes = complete_lines_length(text);
+  f.partial_bytes = text.size() - f.complete_bytes;
+  size_t pos = 0, line = 0;
+  while (pos < f.complete_bytes) {
+    const size_t end = text.find('\n', pos);
+    ++line;
+    const std::string l = text.substr(pos, end - pos);
+    pos = end + 1;
+    if (trim(l).empty()) continue;
+    try {
+      f.records.push_back(sweep_record_from_json(json::parse(l)));
+    } catch (const std::exception& e) {
+      throw std::runtime_error(path + ":" + std::to_string(line) + ": not a sweep record: " + e.what());
+    }
+  }
+  return f;
+}
+
+RecordsFile recover_records(const std::string& path) {
+  RecordsFile f = read_records(path);
+  if (f.partial_bytes == 0) return f;
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error(path + ": cannot open to drop a partial line: " + std::strerror(errno));
+  const bool ok = ::ftruncate(fd, static_cast<off_t>(f.complete_bytes)) == 0 && ::fsync(fd) == 0;
+  const int err = errno;
+  ::close(fd);
+  if (!ok) throw std::runtime_error(path + ": cannot drop a partial line: " + std::strerror(err));
+  return f;
+}
+
+// ---- running ----------------------------------------------------------------------------------
+
+namespace {
+
+// The reference of one scene, shared read-only by every point of it.
+struct Reference {
+  RunRecord record;
+  Trajectory trajectory;
+  bool cached = false;
+};
+
+std::string analytic_version(const Scene& scene) { return make_simulator("analytic", scene)->version(); }
+
+// Same rule as the comparison cache: same physics, same build of the reference, complete files.
+bool load_reference(const fs::path& dir, const Scene& scene, const std::string& hash, Reference& ref) {
+  const fs::path summary = dir / "summary.json", csv = dir / "trajectory.csv";
+  std::error_code ec;
+  if (!fs::exists(summary, ec) || !fs::exists(csv, ec)) return false;
+  try {
+    std::ifstream in(summary);
+    const RunRecord r = from_json(json::parse(in));
+    if (r.engine != "analytic" || physics_hash(r.scene_spec) != hash) return false;
+    if (r.provenance.git_commit != build_info().git_commit || r.engine_version != analytic_version(scene)) return false;
+    Trajectory tr = Trajectory::from_csv(read_trajectory_csv(csv.string()));
+    if (static_cast<long long>(tr.size()) != r.samples) return false;
+    ref.record = r;
+    ref.trajectory = std::move(tr);
+    ref.cached = true;
+    return true;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// Runs the reference at the scene's own tolerances into the cache; the summary goes last, so its
+// presence says the trajectory beside it is complete.
+void compute_reference(const fs::path& dir, const Scene& scene, Reference& ref) {
+  fs::create_directories(dir);
+  CsvTrajectoryWriter csv((dir / "trajectory.csv").string());
+  TrajectorySink sink({&csv});
+  auto sim = make_simulator("analytic", scene);
+  ref.record = run_simulator(*sim, scene, &sink);
+  sim.reset();
+  if (ref.record.status == to_string(RunStatus::Failed) || sink.trajectory.size() == 0)
+    throw std::runtime_error("reference run of " + scene.name + " failed: " + ref.record.status_detail);
+  csv.commit();
+  write_file_atomic((dir / "summary.json").string(), to_json(ref.record).dump(2) + "\n");
+  ref.trajectory = std::move(sink.trajectory);
+}
+
+json settings_object(const SettingsList& s) {
+  json o = json::object();
+  for (const auto& [k, v] : s) o[k] = v;
+  return o;
+}
+
+std::string exception_text(const std::exception_ptr& e) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::exception& x) {
+    return x.what();
+  } catch (...) {
+    return "unknown exception";
+  }
+}
+
+// Runs one point `repeats` times on the calling thread; errors come from the first run (the
+// runs are deterministic), the CPU time is the minimum, so that a busy machine inflates it least.
+SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Reference& ref) {
+  const SweepSetup& setup = plan.spec.setups[p.setup_index];
+  SweepRecord r;
+  r.point_id = p.id;
+  r.scene = p.scene.name;
+  r.scene_file = plan.spec.scenes[p.scene_index].file;
+  r.physics_hash = plan.physics_hashes[p.scene_index];
+  r.scene_index = static_cast<long long>(p.scene_index);
+  r.setup = setup.name;
+  r.engine = setup.engine;
+  r.set = setup.set;
+  r.ladder_key = setup.ladder_key;
+  r.ladder_value = setup.ladder_values[p.ladder_index];
+  r.setup_index = static_cast<long long>(p.setup_index);
+  r.ladder_index = static_cast<long long>(p.ladder_index);
+  r.repeats = plan.spec.repeats;
+  r.duration = p.scene.run.duration;
+  r.reference_inversion_time = ref.record.inversion_time;
+  r.reference_stem_contact_time = ref.record.stem_contact_time;
+  r.git_commit = build_info().git_commit;
+
+  RunRecord first;
+  TrajectorySink sink;
+  double cpu_min = std::numeric_limits<double>::infinity(), wall_min = cpu_min;
+  for (int k = 0; k < plan.spec.repeats; ++k) {
+    RunRecord run;
+    std::unique_ptr<Simulator> sim;
+    try {
+      sim = make_simulator(setup.engine, p.scene);
+      run = run_simulator(*sim, p.scene, k == 0 ? &sink : nullptr);
+    } catch (...) {
+      // An engine that refuses the scene or throws mid-run is a failed point, not a failed sweep.
+      run = RunRecord{};
+      run.engine = setup.engine;
+      run.status = to_string(RunStatus::Failed);
+      run.status_time = sink.trajectory.size() ? sink.trajectory.t.back() : 0.0;
+      run.status_detail = "exception: " + exception_text(std::current_exception());
+      if (sim) {
+        run.engine_version = sim->version();
+        run.settings = sim->settings();
+        run.work = sim->work();
+      }
+      if (k == 0) first = run;
+      break;
+    }
+    cpu_min = std::min(cpu_min, run.work.cpu_seconds);
+    wall_min = std::min(wall_min, run.work.wall_seconds);
+    r.cpu_seconds_repeats.push_back(run.work.cpu_seconds);
+    if (k == 0) first = std::move(run);
+  }
+  if (r.cpu_seconds_repeats.empty()) {
+    cpu_min = first.work.cpu_seconds;
+    wall_min = first.work.wall_seconds;
+    r.cpu_seconds_repeats.push_back(cpu_min);
+  }
+
+  r.status = first.status;
+  r.status_time = first.status_time;
+  r.status_detail = first.status_detail;
+  r.inversion_time = first.inversion_time;
+  r.stem_contact_time = first.stem_contact_time;
+  r.metrics = compare_runs(ref.record, ref.trajectory, first, sink.trajectory, p.scene);
+  r.cpu_seconds = cpu_min;
+  r.wall_seconds = wall_min;
+  r.metrics.cpu_seconds = cpu_min;
+  r.metrics.wall_seconds = wall_min;
+  r.metrics.cost_ratio = ref.record.work.cpu_seconds > 0 ? cpu_min / ref.record.work.cpu_seconds : 0.0;
+  r.metrics.real_time_factor = wall_min > 0 && std::isfinite(first.final_time) ? first.final_time / wall_min : 0.0;
+  r.steps = first.work.steps;
+  r.rhs_evaluations = first.work.rhs_evaluations;
+  r.solver_iterations = first.work.solver_iterations;
+  r.engine_version = first.engine_version.empty() ? "unknown" : first.engine_version;
+  r.settings = settings_object(first.settings);
+  return r;
+}
+
+// A priori cost of a point in arbitrary units: steps for a time-step ladder; per setup, the
+// progress line scales it by the seconds per unit measured on that setup's finished points.
+double point_weight(const SweepPlan& plan, const SweepPoint& p) {
+  const SweepSetup& s = plan.spec.setups[p.setup_index];
+  const double v = s.ladder_values[p.ladder_index];
+  const double per_time =
+      s.ladder_key.size() >= 8 && s.ladder_key.compare(s.ladder_key.size() - 8, 8, "timestep") == 0 && v > 0
+          ? 1.0 / v
+          : (s.engine == "analytic" ? 100.0 : 1e4);
+  return plan.spec.repeats * p.scene.run.duration * per_time;
+}
+
+std::string clock_text(double seconds) {
+  const long long s = static_cast<long long>(std::llround(std::max(0.0, seconds)));
+  char buf[32];
+  if (s >= 3600)
+    std::snprintf(buf, sizeof buf, "%lld:%02lld:%02lld", s / 3600, s / 60 % 60, s % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%lld:%02lld", s / 60, s % 60);
+  return buf;
+}
+
+// The one progress line: points done, what runs, elapsed and an estimate of the time left. Each
+// setup's wall time is fitted as a + b * weight over its finished points: a is the per-point
+// overhead (a MuJoCo model compile, the comparison), which would make a plain ratio taken on a
+// short point overestimate every long one.
+class SweepProgress {
+ public:
+  SweepProgress(const SweepPlan& plan, std::vector<size_t> todo, size_t skipped, int jobs)
+      : plan_(plan),
+        todo_(std::move(todo)),
+        skipped_(skipped),
+        jobs_(jobs),
+        start_(now()),
+        started_(plan.points.size(), -1.0),
+        finished_(plan.points.size(), false) {}
+
+  void begin(size_t point) {
+    std::lock_guard<std::mutex> lock(m_);
+    started_[point] = now() - start_;
+  }
+  void end(size_t point, double wall) {
+    std::lock_guard<std::mutex> lock(m_);
+    finished_[point] = true;
+    ++done_;
+    samples_[plan_.points[point].setup_index].emplace_back(point_weight(plan_, plan_.points[point]), wall);
+  }
+
+  void print(bool final_line) {
+    std::lock_guard<std::mutex> lock(m_);
+    const double elapsed = now() - start_;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "[sweep] %zu/%zu points", done_ + skipped_, plan_.points.size());
+    std::string line = buf;
+    if (skipped_) line += " (" + std::to_string(skipped_) + " from an earlier run)";
+    size_t running = 0;
+    for (size_t p : todo_) running += started_[p] >= 0 && !finished_[p];
+    if (!final_line) line += " | " + std::to_string(running) + " running";
+    line += " | " + clock_text(elapsed) + " elapsed";
+    if (!final_line) {
+      const double left = estimate_left(elapsed);
+      line += std::isfinite(left) ? " | ~" + clock_text(left) + " left" : " | estimating";
+    }
+    const size_t len = line.size();
+    if (line.size() < width_) line.append(width_ - line.size(), ' ');
+    width_ = len;
+    std::fprintf(stderr, "\r%s", line.c_str());
+    if (final_line) std::fputc('\n', stderr);
+    std::fflush(stderr);
+  }
+
+ private:
+  static double now() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
+  // Expected wall seconds of a point of weight w of this setup; NaN before any point finished.
+  double expect(size_t setup, double w) const {
+    auto it = samples_.find(setup);
+    double sw = 0, st = 0;
+    if (it == samples_.end()) {
+      // No point of this setup yet: the ratio over every finished point.
+      for (const auto& [s, v] : samples_)
+        for (const auto& [x, t] : v) {
+          sw += x;
+          st += t;
+        }
+      return sw > 0 ? st / sw * w : std::nan("");
+    }
+    const auto& v = it->second;
+    double sww = 0, swt = 0;
+    for (const auto& [x, t] : v) {
+      sw += x;
+      st += t;
+      sww += x * x;
+      swt += x * t;
+    }
+    const double n = static_cast<double>(v.size()), det = n * sww - sw * sw;
+    if (v.size() >= 2 && det > 1e-12 * sww * n) {
+      const double b = (n * swt - sw * st) / det, a = (st - b * sw) / n;
+      if (b > 0 && a >= 0) return a + b * w;
+    }
+    return sw > 0 ? st / sw * w : std::nan("");
+  }
+  double estimate_left(double elapsed) const {
+    if (samples_.empty()) return std::nan("");
+    double left = 0;
+    for (size_t p : todo_) {
+      if (finished_[p]) continue;
+      const double expect = this->expect(plan_.points[p].setup_index, point_weight(plan_, plan_.points[p]));
+      left += started_[p] >= 0 ? std::max(0.0, expect - (elapsed - started_[p])) : expect;
+    }
+    return left / jobs_;
+  }
+
+  const SweepPlan& plan_;
+  std::vector<size_t> todo_;
+  size_t skipped_;
+  int jobs_;
+  double start_;
+  std::mutex m_;
+  std::vector<double> started_;
+  std::vector<bool> finished_;
+  size_t done_ = 0;
+  std::map<size_t, std::vector<std::pair<double, double>>> samples_;  // setup -> (weight, wall)
+  size_t width_ = 0;
+};
+
+// Appends whole lines to records.jsonl, each flushed to disk before the next point is counted.
+class RecordAppender {
+ public:
+  explicit RecordAppender(const fs::path& path) : path_(path.string()) {
+    const bool existed = fs::exists(path);
+    fd_ = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw std::runtime_error(path_ + ": cannot open: " + std::strerror(errno));
+    if (!existed) {
+      // The new file's directory entry must survive a crash too.
+      const int dir = ::open(path.parent_path().empty() ? "." : path.parent_path().c_str(), O_RDONLY | O_CLOEXEC);
+      if (dir >= 0) {
+        ::fsync(dir);
+        ::close(dir);
+      }
+    }
+  }
+  ~RecordAppender() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  RecordAppender(const RecordAppender&) = delete;
+  RecordAppender& operator=(const RecordAppender&) = delete;
+
+  void append(const std::string& line) {
+    std::lock_guard<std::mutex> lock(m_);
+    size_t off = 0;
+    while (off < line.size()) {
+      const ssize_t n = ::write(fd_, line.data() + off, line.size() - off);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) throw std::runtime_error(path_ + ": cannot write: " + std::strerror(errno));
+      off += static_cast<size_t>(n);
+    }
+    if (::fsync(fd_) != 0) throw std::runtime_error(path_ + ": cannot sync: " + std::strerror(errno));
+  }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  std::mutex m_;
+};
+
+// Holds an exclusive lock on DIR/.lock for the life of a run, so two sweeps never append to the
+// same records.
+class DirLock {
+ public:
+  explicit DirLock(const fs::path& dir) {
+    const std::string path = (dir / ".lock").string();
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw std::runtime_error(path + ": cannot open: " + std::strerror(errno));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      fd_ = -1;
+      throw SweepInputError(dir.string() + ": in use by another tippe sweep");
+    }
+  }
+  ~DirLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  DirLock(const DirLock&) = delete;
+  DirLock& operator=(const DirLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+// Runs fn(0..n-1) on `jobs` threads; the first exception is rethrown after every thread ends.
+void parallel_for(size_t n, int jobs, const std::function<void(size_t)>& fn, const std::function<void()>& idle = {}) {
+  std::atomic<size_t> next{0}, finished{0};
+  std::exception_ptr error;
+  std::mutex error_m;
+  std::atomic<bool> stop{false};
+  auto worker = [&] {
+    for (size_t k; !stop.load() && (k = next.fetch_add(1)) < n;) {
+      try {
+        fn(k);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_m);
+        if (!error) error = std::current_exception();
+        stop.store(true);
+      }
+      finished.fetch_add(1);
+    }
+  };
+  const size_t threads = std::min(static_cast<size_t>(std::max(jobs, 1)), std::max<size_t>(n, 1));
+  std::vector<std::thread> pool;
+  for (size_t i = 0; i < threads; ++i) pool.emplace_back(worker);
+  if (idle) {
+    // Five redraws a second; the short naps end the wait soon after the last task.
+    auto last = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+    while (finished.load() < n && !stop.load()) {
+      if (std::chrono::steady_clock::now() - last >= std::chrono::milliseconds(200)) {
+        idle();
+        last = std::chrono::steady_clock::now();
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+json sweep_json(const SweepPlan& plan) {
+  const Provenance p = current_provenance();
+  json scenes = json::array(), setups = json::array();
+  for (const Scene& s : plan.scenes) scenes.push_back(s.name);
+  for (const SweepSetup& s : plan.spec.setups) setups.push_back(s.name);
+  return json{{"format", "tippe-sweep-1"},
+              {"sweep_file", plan.spec.file},
+              {"sweep_hash", plan.spec.hash},
+              {"plan_hash", plan.plan_hash},
+              {"description", plan.spec.description},
+              {"repeats", plan.spec.repeats},
+              {"points", plan.points.size()},
+              {"scenes", scenes},
+              {"setups", setups},
+              {"sweep_text", plan.spec.text},
+              {"provenance",
+               {{"git_commit", p.git_commit},
+                {"compiler", p.compiler},
+                {"cxx_flags", p.cxx_flags},
+                {"date", p.date},
+                {"hostname", p.hostname}}}};
+}
+
+}  // namespace
+
+SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o) {
+  if (o.jobs < 1) throw SweepInputError("jobs must be at least 1, got " + std::to_string(o.jobs));
+  if (o.out_dir.empty()) throw SweepInputError("no output directory");
+  const fs::path out = o.out_dir;
+  const fs::path sweep_file = out / "sweep.json", records_file = out / "records.jsonl";
+
+  // What OUT holds is checked before anything is written to it.
+  bool fresh = true;
+  std::error_code ec;
+  if (fs::exists(sweep_file, ec)) {
+    json old;
+    try {
+      std::ifstream in(sweep_file);
+      old = json::parse(in);
+      const std::string h = old.at("sweep_hash").get<std::string>(), ph = old.at("plan_hash").get<std::string>();
+      if (h != plan.spec.hash && !o.restart)
+        throw SweepInputError(sweep_file.string() + ": sweep_hash: " + out.string() +
+                              " was started with another sweep file (hash " + h + ", " + plan.spec.file + " now has " +
+                              plan.spec.hash + "); give --restart to begin it again, or another --out");
+      if (ph != plan.plan_hash && !o.restart)
+        throw SweepInputError(sweep_file.string() + ": plan_hash: the physics of a scene of " + plan.spec.file +
+                              " changed since " + out.string() +
+                              " was started; give --restart to begin it again, or another --out");
+      fresh = h != plan.spec.hash || ph != plan.plan_hash;
+    } catch (const json::exception& e) {
+      if (!o.restart)
+        throw SweepInputError(sweep_file.string() + ": not a sweep record (" + e.what() +
+                              "); give --restart to begin the directory again");
+    }
+  } else if (fs::exists(records_file, ec) && !o.restart) {
+    throw SweepInputError(records_file.string() + ": records without " + sweep_file.string() +
+                          "; give --restart to begin the directory again, or another --out");
+  }
+
+  std::error_code mk;
+  fs::create_directories(out, mk);
+  if (mk) throw SweepInputError(out.string() + ": cannot create the output directory: " + mk.message());
+  DirLock lock(out);
+  SweepOutcome outcome;
+  outcome.points = plan.points.size();
+  if (fresh || o.restart) {
+    // Beginning again: earlier records are kept aside, never silently mixed with the new ones.
+    if (fs::exists(records_file, ec)) fs::rename(records_file, out / "records.jsonl.old");
+    write_file_atomic(sweep_file.string(), sweep_json(plan).dump(2) + "\n");
+  }
+
+  const RecordsFile existing = recover_records(records_file.string());
+  outcome.partial_bytes_dropped = existing.partial_bytes;
+  if (existing.partial_bytes)
+    std::fprintf(stderr, "tippe: %s: dropped a partial last line (%zu bytes); its point runs again\n",
+                 records_file.string().c_str(), existing.partial_bytes);
+  std::set<std::string> done;
+  size_t duplicates = 0;
+  for (const SweepRecord& r : existing.records) duplicates += !done.insert(r.point_id).second;
+  if (duplicates)
+    std::fprintf(stderr, "tippe: warning: %s: %zu duplicate point ids (the report uses the first)\n",
+                 records_file.string().c_str(), duplicates);
+
+  std::vector<size_t> todo;
+  for (size_t i = 0; i < plan.points.size(); ++i)
+    if (!done.count(plan.points[i].id)) todo.push_back(i);
+  outcome.skipped = plan.points.size() - todo.size();
+  // The two cheapest points of each setup first: a few seconds in, every setup's overhead and
+  // seconds per unit of weight are measured and the time left is a real estimate. Then the
+  // longest first, so that the last point to finish is a short one and the cores stay busy.
+  std::stable_sort(todo.begin(), todo.end(), [&](size_t a, size_t b) {
+    return point_weight(plan, plan.points[a]) > point_weight(plan, plan.points[b]);
+  });
+  std::vector<size_t> order;
+  std::map<size_t, int> calibration;
+  std::set<size_t> first;
+  for (auto it = todo.rbegin(); it != todo.rend(); ++it)
+    if (++calibration[plan.points[*it].setup_index] <= 2) {
+      order.push_back(*it);
+      first.insert(*it);
+    }
+  for (size_t p : todo)
+    if (!first.count(p)) order.push_back(p);
+  todo = std::move(order);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Reference> refs(plan.scenes.size());
+  std::vector<size_t> needed;
+  for (size_t i = 0; i < plan.scenes.size(); ++i)
+    if (std::any_of(todo.begin(), todo.end(), [&](size_t p) { return plan.points[p].scene_index == i; }))
+      needed.push_back(i);
+  std::vector<size_t> to_compute;
+  for (size_t i : needed) {
+    const fs::path dir = out / "reference" / plan.physics_hashes[i];
+    if (load_reference(dir, plan.scenes[i], plan.physics_hashes[i], refs[i]))
+      ++outcome.references_cached;
+    else
+      to_compute.push_back(i);
+  }
+  if (o.progress && !to_compute.empty())
+    std::fprintf(stderr, "[sweep] computing %zu reference(s)\n", to_compute.size());
+  parallel_for(to_compute.size(), o.jobs, [&](size_t k) {
+    const size_t i = to_compute[k];
+    compute_reference(out / "reference" / plan.physics_hashes[i], plan.scenes[i], refs[i]);
+  });
+
+  if (!todo.empty()) {
+    RecordAppender appender(records_file);
+    SweepProgress progress(plan, todo, outcome.skipped, o.jobs);
+    auto run_one = [&](size_t k) {
+      const size_t p = todo[k];
+      progress.begin(p);
+      const auto start = std::chrono::steady_clock::now();
+      const SweepRecord r = run_point(plan, plan.points[p], refs[plan.points[p].scene_index]);
+      appender.append(to_jsonl(r));
+      progress.end(p, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    };
+    std::function<void()> idle;
+    if (o.progress) idle = [&] { progress.print(false); };
+    parallel_for(todo.size(), o.jobs, run_one, idle);
+    if (o.progress) progress.print(true);
+  }
+  outcome.ran = todo.size();
+  outcome.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  write_sweep_report(out.string(), read_records(records_file.string()).records, o.plots);
+  return outcome;
+}
+
+}  // namespace tippe

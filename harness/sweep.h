@@ -1,0 +1,199 @@
+// Work-precision sweeps: sweep files, their points, resumable runs into records.jsonl, and the report's analysis.
+#pragma once
+
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "compare.h"
+#include "scene.h"
+
+namespace tippe {
+
+// ---- sweep files ------------------------------------------------------------------------------
+
+// One entry of `scenes`: a path (relative to the sweep file) or a table {file, duration}.
+struct SweepScene {
+  std::string file;                // as written in the sweep file
+  std::string path;                // resolved against the sweep file's directory
+  std::optional<double> duration;  // this scene's own override of run.duration
+};
+
+// One [[setup]]: an engine, fixed overrides, and the key swept over `values`.
+struct SweepSetup {
+  std::string name, engine;
+  std::vector<std::string> set;  // "KEY=VALUE" overrides, as written
+  std::string ladder_key;
+  std::vector<double> ladder_values;
+  std::vector<std::string> ladder_texts;  // each value as a TOML value (integers stay integers)
+};
+
+struct SweepSpec {
+  std::string file;  // as given
+  std::string hash;  // FNV-1a 64 of the file's bytes (16 hex digits)
+  std::string text;  // the file's bytes
+  std::string description;
+  int repeats = 1;                 // timing repeats per point; the minimum CPU time is kept
+  std::optional<double> duration;  // override of every scene's run.duration
+  std::vector<SweepScene> scenes;
+  std::vector<SweepSetup> setups;
+};
+
+// One run of a sweep: a scene with a setup's overrides and one ladder value applied.
+struct SweepPoint {
+  size_t scene_index = 0, setup_index = 0, ladder_index = 0;
+  std::string id;  // sweep_point_id(...)
+  Scene scene;     // as run (every override applied)
+};
+
+// A sweep file with every scene and point loaded and checked.
+struct SweepPlan {
+  SweepSpec spec;
+  std::vector<Scene> scenes;                // the reference's scenes (duration override applied)
+  std::vector<std::string> physics_hashes;  // physics_hash of each of those
+  std::vector<SweepPoint> points;           // scene-major, then setup, then ladder order
+  std::string plan_hash;                    // hash over the point ids: changes when any scene's physics does
+};
+
+// Reads and checks a sweep file and every point it expands to. Throws SceneError
+// "FILE: KEY: reason" (KEY dotted with 0-based indices, e.g. "setup[1].ladder.values[2]"), or
+// "FILE:LINE:COL: reason" for TOML syntax. Rules:
+//  - top level: description (string, one line), repeats (integer 1..100, default 1), duration
+//    (number > 0), scenes (non-empty array), setup (non-empty array of tables); nothing else.
+//  - scenes[i]: a path, or {file = PATH, duration = NUMBER > 0}; relative to the sweep file;
+//    each must load as a scene (its own error is quoted); no scene listed twice.
+//  - setup[i]: name (letters, digits, '.', '_', '-'; unique), engine (one of
+//    available_engines()), set (array of "KEY=VALUE" strings, optional), ladder = {key, values}
+//    (values a non-empty array of distinct finite numbers). A setup may only touch its engine's
+//    settings (engines.ENGINE.*) or, for the analytic model, run.rtol, run.atol and run.method:
+//    a sweep never changes the physics. The ladder key may not also be in `set`.
+//  - every scene with every setup and ladder value must load (the scene's checks and
+//    validate_engine_settings); the scene's message is quoted after the sweep key.
+SweepPlan load_sweep(const std::string& path);
+
+// FNV-1a 64 of the parts, each followed by a 0 byte, as 16 hex digits.
+std::string fnv1a_hex(const std::vector<std::string>& parts);
+// Stable id of a point: hash of the scene's physics, the setup (name, engine, overrides, key),
+// the ladder value's text and the repeats.
+std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& setup, const std::string& value_text,
+                           int repeats);
+
+// ---- records ----------------------------------------------------------------------------------
+
+// One line of records.jsonl: a finished point, with everything the report needs.
+struct SweepRecord {
+  std::string point_id;
+  std::string scene, scene_file, physics_hash;
+  long long scene_index = 0;
+  std::string setup, engine;
+  std::vector<std::string> set;
+  std::string ladder_key;
+  double ladder_value = 0;
+  long long setup_index = 0, ladder_index = 0;
+  long long repeats = 1;
+  double duration = 0;  // the scene's run.duration as run
+  std::string status = "ok";
+  double status_time = 0;
+  std::string status_detail;
+  std::optional<double> inversion_time, stem_contact_time;  // this run's first events
+  std::optional<double> reference_inversion_time, reference_stem_contact_time;
+  Metrics metrics;         // compare_runs against the reference; its cpu/wall/cost fields are the minima below
+  double cpu_seconds = 0;  // the run's own thread, minimum over the repeats
+  std::vector<double> cpu_seconds_repeats;  // every repeat, in order
+  double wall_seconds = 0;                  // minimum over the repeats
+  long long steps = 0, rhs_evaluations = 0, solver_iterations = 0;
+  std::string engine_version, git_commit;
+  nlohmann::json settings = nlohmann::json::object();  // every accuracy setting in force
+};
+nlohmann::json to_json(const SweepRecord& r);
+// Throws nlohmann::json::exception for a missing or mistyped field, std::invalid_argument for
+// another format.
+SweepRecord sweep_record_from_json(const nlohmann::json& j);
+// One line of records.jsonl, '\n' included.
+std::string to_jsonl(const SweepRecord& r);
+
+// Length of the longest prefix of `text` that is made of complete ('\n'-terminated) lines.
+size_t complete_lines_length(const std::string& text);
+
+struct RecordsFile {
+  std::vector<SweepRecord> records;  // complete lines, in file order
+  size_t complete_bytes = 0;         // bytes of the complete lines
+  size_t partial_bytes = 0;          // a last line without '\n' (a write cut short), dropped
+};
+// Reads records.jsonl (a missing file is empty). A complete line that is not a record throws
+// std::runtime_error "FILE:LINE: reason"; a partial last line is only measured.
+RecordsFile read_records(const std::string& path);
+// read_records, then truncates the file to its complete lines (fsynced) when the last is partial.
+RecordsFile recover_records(const std::string& path);
+
+// ---- running ----------------------------------------------------------------------------------
+
+struct SweepOptions {
+  std::string out_dir;
+  int jobs = 1;
+  bool restart = false;  // a DIR started with another sweep file (or other scene physics) is begun again
+  bool progress = true;  // progress line with the time left on stderr
+  bool plots = true;     // gnuplot SVGs in the report
+};
+
+// Input a sweep cannot start with (jobs < 1, an output directory started with another sweep,
+// or in use): found before anything is written; `tippe sweep` exits 2.
+class SweepInputError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+struct SweepOutcome {
+  size_t points = 0, skipped = 0, ran = 0;  // skipped: finished by an earlier run of the same DIR
+  size_t references_cached = 0;
+  size_t partial_bytes_dropped = 0;
+  double wall_seconds = 0;
+};
+
+// Runs every point of `plan` not yet in OUT/records.jsonl, on `jobs` threads, appending one
+// fsynced line per finished point; then writes the report. Layout of OUT: sweep.json (the sweep
+// file, its hash and the plan hash), records.jsonl, reference/<physics_hash>/{summary.json,
+// trajectory.csv}, report.md, index.html, *.svg. Throws SweepInputError before anything is
+// written; an engine that diverges or throws is a point with that status, not an error.
+SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& options);
+
+// ---- analysis (pure functions of records) -----------------------------------------------------
+
+// Empirical order of convergence: least-squares slope of log(error) against log(h) over the
+// asymptotic range, found as the longest run of consecutive points (in h) whose local slopes are
+// all >= 0.5 (the error really falls with h: a floor or saturation is left out) and within
+// max(0.25, 0.15 p) of the fitted slope p; ties go to the smaller residual, then the finer points.
+struct ConvergenceFit {
+  bool ok = false;  // at least two points in the range
+  double order = 0;
+  std::vector<size_t> used;  // indices into the input, in increasing h
+  std::string note;          // why not, or "only 2 points"
+};
+// h and error of the same length; non-finite or non-positive pairs are ignored.
+ConvergenceFit convergence_order(const std::vector<double>& h, const std::vector<double>& error);
+
+// The cheapest point (least cpu_seconds; ties: fewer steps) among `records` with status ok and
+// |inversion_time_rel_error| < threshold; -1 when none.
+long long cheapest_below(const std::vector<SweepRecord>& records, double threshold);
+// The cheapest point with status ok and |inversion_time_rel_error| <= error; -1 when none.
+long long cheapest_at_least_as_accurate(const std::vector<SweepRecord>& records, double error);
+
+// Whether a point is in the reference's regime: the reference inverts and so does the run (status
+// ok or not), or the reference does not invert and the run finished (status ok) without inverting.
+bool agrees_with_reference_regime(const SweepRecord& r);
+// Whether a larger value of this ladder key is the softer (cheaper, less accurate) setting:
+// true for time steps and tolerances, false for iteration and substep counts.
+bool larger_is_softer(const std::string& ladder_key);
+// One setup's points: walking from the finest setting to softer ones, the softest reached before
+// the first point out of the reference's regime; -1 when even the finest disagrees or there are
+// no points. Indices into `records`.
+long long softest_agreeing(const std::vector<SweepRecord>& records);
+
+// report.md, index.html and (when `plots`) the SVGs, into dir, from the records alone.
+void write_sweep_report(const std::string& dir, const std::vector<SweepRecord>& records, bool plots);
+std::string render_sweep_markdown(const std::vector<SweepRecord>& records);
+
+}  // namespace tippe

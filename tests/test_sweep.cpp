@@ -1,0 +1,619 @@
+// Tests of `tippe sweep`: records, the analysis on synthetic data, sweep-file checks, and a killed sweep resumed.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "scene_io.h"
+#include "sweep.h"
+
+namespace fs = std::filesystem;
+using namespace tippe;
+using nlohmann::json;
+
+namespace {
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "tippe-sweep-XXXXXX").string();
+    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = tmpl;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void spit(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+const std::string kSource = std::string(TIPPE_SOURCE_DIR);
+const std::string kBinary = std::string(TIPPE_BINARY_DIR) + "/tippe";
+const std::string kSmoke = kSource + "/harness/sweeps/smoke.toml";
+const std::string kScene = kSource + "/harness/scenes/source_dimensionless.toml";
+
+SweepRecord sample_record() {
+  SweepRecord r;
+  r.point_id = "0123456789abcdef";
+  r.scene = "source_dimensionless";
+  r.scene_file = "../scenes/source_dimensionless.toml";
+  r.physics_hash = "fedcba9876543210";
+  r.scene_index = 1;
+  r.setup = "mujoco-rk4";
+  r.engine = "mujoco";
+  r.set = {"engines.mujoco.integrator=\"RK4\""};
+  r.ladder_key = "engines.mujoco.timestep";
+  r.ladder_value = 3e-5;
+  r.setup_index = 2;
+  r.ladder_index = 4;
+  r.repeats = 3;
+  r.duration = 25.0;
+  r.status = "diverged";
+  r.status_time = 12.345678901234567;
+  r.status_detail = "|omega| > 1e6 \"quoted\"\nsecond line";
+  r.inversion_time = std::nullopt;
+  r.stem_contact_time = 0.1 + 0.2;
+  r.reference_inversion_time = 17.251740062499294;
+  r.reference_stem_contact_time = std::nullopt;
+  r.metrics.inversion_event = "reference_only";
+  r.metrics.stem_contact_event = "engine_only";
+  r.metrics.tilt_rms_error = 1.0 / 3.0;
+  r.metrics.tilt_max_error = std::nan("");  // written as null, read back as NaN
+  r.metrics.energy_max_error = 2.5e-7;
+  r.metrics.contact_path_rms_error = 4e-3;
+  r.metrics.jellett_drift_ball = 1e-9;
+  r.metrics.steps = 123456;
+  r.cpu_seconds = 0.25;
+  r.cpu_seconds_repeats = {0.3, 0.25, 0.27};
+  r.wall_seconds = 0.26;
+  r.steps = 123456;
+  r.rhs_evaluations = 123456;
+  r.solver_iterations = 98765;
+  r.engine_version = "mujoco 2.2.2";
+  r.git_commit = "abcdef012345";
+  r.settings = {{"timestep", "3.0000000000000001e-05"}, {"integrator", "RK4"}};
+  return r;
+}
+
+// A record with only what the analysis reads.
+SweepRecord point(const std::string& engine, const std::string& setup, double value, double cpu,
+                  std::optional<double> inversion_error, const std::string& status = "ok") {
+  SweepRecord r;
+  r.point_id = engine + setup + std::to_string(value);
+  r.engine = engine;
+  r.setup = setup;
+  r.ladder_key = "engines." + engine + ".timestep";
+  r.ladder_value = value;
+  r.cpu_seconds = cpu;
+  r.steps = static_cast<long long>(1.0 / value);
+  r.status = status;
+  r.reference_inversion_time = 10.0;
+  if (inversion_error) {
+    r.metrics.inversion_event = "both";
+    r.metrics.inversion_time_rel_error = inversion_error;
+    r.inversion_time = 10.0 * (1 + *inversion_error);
+  } else {
+    r.metrics.inversion_event = "reference_only";
+  }
+  return r;
+}
+
+}  // namespace
+
+// ---- records ----------------------------------------------------------------------------------
+
+TEST(SweepRecords, JsonLineRoundTrip) {
+  const SweepRecord r = sample_record();
+  const std::string line = to_jsonl(r);
+  ASSERT_EQ(line.back(), '\n');
+  EXPECT_EQ(line.find('\n'), line.size() - 1) << "one record, one line";
+  const SweepRecord back = sweep_record_from_json(json::parse(line));
+  EXPECT_EQ(to_jsonl(back), line);
+  EXPECT_EQ(back.point_id, r.point_id);
+  EXPECT_EQ(back.set, r.set);
+  EXPECT_EQ(back.ladder_value, 3e-5);
+  EXPECT_FALSE(back.inversion_time);
+  EXPECT_EQ(*back.stem_contact_time, 0.1 + 0.2);
+  EXPECT_TRUE(std::isnan(back.metrics.tilt_max_error));
+  EXPECT_EQ(back.metrics.tilt_rms_error, 1.0 / 3.0);
+  EXPECT_EQ(back.cpu_seconds_repeats, r.cpu_seconds_repeats);
+  EXPECT_EQ(back.status_detail, r.status_detail);
+  EXPECT_EQ(back.settings, r.settings);
+}
+
+TEST(SweepRecords, MissingFieldOrOtherFormatThrows) {
+  json j = to_json(sample_record());
+  j.erase("point_id");
+  EXPECT_THROW(sweep_record_from_json(j), json::exception);
+  json k = to_json(sample_record());
+  k["format"] = "tippe-sweep-record-0";
+  EXPECT_THROW(sweep_record_from_json(k), std::invalid_argument);
+}
+
+TEST(SweepRecords, PartialLastLineIsDetectedAndDropped) {
+  EXPECT_EQ(complete_lines_length(""), 0u);
+  EXPECT_EQ(complete_lines_length("{\"a\""), 0u);
+  EXPECT_EQ(complete_lines_length("one\ntwo\n"), 8u);
+  EXPECT_EQ(complete_lines_length("one\ntwo\nthr"), 8u);
+
+  TempDir dir;
+  const fs::path file = dir.path() / "records.jsonl";
+  EXPECT_TRUE(read_records(file.string()).records.empty()) << "a missing file is empty";
+  SweepRecord a = sample_record(), b = sample_record();
+  b.point_id = "1111111111111111";
+  const std::string whole = to_jsonl(a) + to_jsonl(b);
+  const std::string cut = to_jsonl(a).substr(0, 57);
+  spit(file, whole + cut);
+
+  const RecordsFile seen = read_records(file.string());
+  ASSERT_EQ(seen.records.size(), 2u);
+  EXPECT_EQ(seen.complete_bytes, whole.size());
+  EXPECT_EQ(seen.partial_bytes, cut.size());
+  EXPECT_EQ(fs::file_size(file), whole.size() + cut.size()) << "reading leaves the file alone";
+
+  const RecordsFile fixed = recover_records(file.string());
+  EXPECT_EQ(fixed.records.size(), 2u);
+  EXPECT_EQ(fixed.partial_bytes, cut.size());
+  EXPECT_EQ(slurp(file), whole) << "truncated to the last complete line";
+  EXPECT_EQ(recover_records(file.string()).partial_bytes, 0u);
+}
+
+TEST(SweepRecords, ACorruptCompleteLineNamesFileAndLine) {
+  TempDir dir;
+  const fs::path file = dir.path() / "records.jsonl";
+  spit(file, to_jsonl(sample_record()) + "{\"format\": \"tippe-sweep-record-1\"}\n");
+  try {
+    read_records(file.string());
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string() + ":2:"), std::string::npos) << e.what();
+  }
+}
+
+// ---- analysis ---------------------------------------------------------------------------------
+
+TEST(SweepAnalysis, ExactPowerLawGivesItsOrderOverEveryPoint) {
+  const std::vector<double> h = {1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5};
+  for (double order : {1.0, 2.0, 4.0}) {
+    std::vector<double> e;
+    for (double x : h) e.push_back(7.0 * std::pow(x, order));
+    const ConvergenceFit f = convergence_order(h, e);
+    ASSERT_TRUE(f.ok) << f.note;
+    EXPECT_NEAR(f.order, order, 1e-9);
+    EXPECT_EQ(f.used, (std::vector<size_t>{5, 4, 3, 2, 1, 0})) << "every point, in increasing h";
+  }
+}
+
+TEST(SweepAnalysis, FloorAndSaturationAreLeftOutOfTheAsymptoticRange) {
+  // Error 1000 h^2 above a floor of 1e-7 at the fine end and saturated at 0.5 at the coarse end.
+  const std::vector<double> h = {3e-1, 1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5, 1e-6};
+  std::vector<double> e;
+  for (double x : h) e.push_back(std::min(0.5, 1000 * x * x) + 1e-7);
+  const ConvergenceFit f = convergence_order(h, e);
+  ASSERT_TRUE(f.ok) << f.note;
+  EXPECT_NEAR(f.order, 2.0, 0.1);
+  std::set<double> used;
+  for (size_t i : f.used) used.insert(h[i]);
+  EXPECT_FALSE(used.count(1e-6)) << "on the floor";
+  EXPECT_FALSE(used.count(1e-1)) << "saturated";
+  EXPECT_FALSE(used.count(3e-1)) << "saturated";
+  for (double x : {1e-2, 1e-3, 1e-4}) EXPECT_TRUE(used.count(x)) << x;
+}
+
+TEST(SweepAnalysis, NoConvergenceIsSaid) {
+  EXPECT_FALSE(convergence_order({1e-2, 1e-3, 1e-4}, {0.1, 0.1, 0.1}).ok);
+  EXPECT_FALSE(convergence_order({1e-2}, {0.1}).ok);
+  // Non-finite and zero errors do not count.
+  const ConvergenceFit f = convergence_order({1e-2, 1e-3, 1e-4}, {1e-4, std::nan(""), 0.0});
+  EXPECT_FALSE(f.ok);
+  const ConvergenceFit two = convergence_order({1e-2, 1e-3, 1e-4}, {1e-2, 1e-3, std::nan("")});
+  ASSERT_TRUE(two.ok);
+  EXPECT_NEAR(two.order, 1.0, 1e-12);
+  EXPECT_EQ(two.note, "only 2 points");
+}
+
+TEST(SweepAnalysis, CheapestSettingBelowEachBound) {
+  // Two setups of engine A and one of B; errors of either sign; a diverged run never counts.
+  std::vector<SweepRecord> a = {point("a", "a-euler", 1e-2, 1.0, 0.2), point("a", "a-euler", 1e-3, 2.0, -0.05),
+                                point("a", "a-euler", 1e-4, 4.0, 0.005), point("a", "a-rk4", 1e-2, 3.0, 0.004),
+                                point("a", "a-rk4", 1e-3, 6.0, 0.0002)};
+  EXPECT_EQ(cheapest_below(a, 0.1), 1);
+  EXPECT_EQ(cheapest_below(a, 0.01), 3) << "the RK4 setup is cheaper than Euler at 1e-4";
+  EXPECT_EQ(cheapest_below(a, 0.001), 4);
+  EXPECT_EQ(cheapest_below(a, 1e-5), -1);
+
+  std::vector<SweepRecord> b = {point("b", "b", 1e-2, 0.5, 0.08), point("b", "b", 1e-3, 3.0, 0.0005, "diverged"),
+                                point("b", "b", 1e-4, 5.0, -0.0009), point("b", "b", 1e-5, 9.0, std::nullopt)};
+  EXPECT_EQ(cheapest_below(b, 0.1), 0);
+  EXPECT_EQ(cheapest_below(b, 0.01), 2) << "the diverged point is skipped";
+  EXPECT_EQ(cheapest_below(b, 0.001), 2);
+  EXPECT_EQ(cheapest_below(b, 0.0009), -1) << "the bound is strict";
+
+  // The analytic side: the cheapest point at least as accurate.
+  std::vector<SweepRecord> an = {point("analytic", "bs", 1e-4, 0.002, 1e-5), point("analytic", "bs", 1e-8, 0.004, 1e-9),
+                                 point("analytic", "dp", 1e-4, 0.003, 3e-6)};
+  EXPECT_EQ(cheapest_at_least_as_accurate(an, 0.005), 0);
+  EXPECT_EQ(cheapest_at_least_as_accurate(an, 5e-6), 2);
+  EXPECT_EQ(cheapest_at_least_as_accurate(an, 1e-9), 1) << "equal accuracy counts";
+  EXPECT_EQ(cheapest_at_least_as_accurate(an, 1e-10), -1);
+}
+
+TEST(SweepAnalysis, SoftestSettingInTheReferencesRegime) {
+  // The reference rolls (no inversion): a point agrees when it finishes without inverting.
+  auto rolling = [](double dt, std::optional<double> inversion, const std::string& status = "ok") {
+    SweepRecord r;
+    r.ladder_key = "engines.ode.timestep";
+    r.ladder_value = dt;
+    r.inversion_time = inversion;
+    r.status = status;
+    return r;
+  };
+  std::vector<SweepRecord> s = {rolling(1e-2, 3.0), rolling(3e-3, std::nullopt), rolling(1e-3, std::nullopt),
+                                rolling(1e-4, std::nullopt)};
+  EXPECT_FALSE(agrees_with_reference_regime(s[0]));
+  EXPECT_TRUE(agrees_with_reference_regime(s[1]));
+  EXPECT_EQ(softest_agreeing(s), 1);
+  // Walking from the finest: a diverged run at 3e-3 stops the walk although 1e-2 agrees again.
+  s = {rolling(1e-2, std::nullopt), rolling(3e-3, std::nullopt, "diverged"), rolling(1e-3, std::nullopt)};
+  EXPECT_EQ(softest_agreeing(s), 2);
+  s = {rolling(1e-3, 1.0), rolling(1e-4, 1.0)};
+  EXPECT_EQ(softest_agreeing(s), -1);
+
+  // An inverting reference: a run that inverts agrees, even if it diverges later.
+  SweepRecord inv = rolling(1e-3, 4.0, "diverged");
+  inv.reference_inversion_time = 4.3;
+  EXPECT_TRUE(agrees_with_reference_regime(inv));
+
+  // Iterations: fewer is softer.
+  EXPECT_TRUE(larger_is_softer("engines.mujoco.timestep"));
+  EXPECT_TRUE(larger_is_softer("run.rtol"));
+  EXPECT_FALSE(larger_is_softer("engines.bullet.solver_iterations"));
+  EXPECT_FALSE(larger_is_softer("engines.ode.iterations"));
+  std::vector<SweepRecord> it = {rolling(5, 2.0), rolling(10, std::nullopt), rolling(50, std::nullopt)};
+  for (auto& r : it) r.ladder_key = "engines.ode.iterations";
+  EXPECT_EQ(softest_agreeing(it), 1);
+}
+
+TEST(SweepReport, MarkdownNamesTheCheapestPointsAndOrders) {
+  std::vector<SweepRecord> recs;
+  const std::vector<double> h = {1e-2, 1e-3, 1e-4};
+  long long k = 0;
+  for (double dt : h) {
+    SweepRecord r = point("ode", "ode", dt, 1e-3 / dt, 3.0 * dt * dt);
+    r.scene = "fixture";
+    r.metrics.tilt_rms_error = 0.1 * dt;
+    r.ladder_index = k++;
+    r.point_id = "p" + std::to_string(k);
+    recs.push_back(r);
+  }
+  const std::string md = render_sweep_markdown(recs);
+  EXPECT_NE(md.find("| ode | 1 % | ode | engines.ode.timestep = 0.01 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 2.00 | dt = 0.0001, 0.001, 0.01 | 1.00 |"), std::string::npos) << md;
+  // Duplicated point ids (a line written twice) count once.
+  recs.push_back(recs.front());
+  EXPECT_EQ(render_sweep_markdown(recs), md);
+}
+
+// ---- sweep files ------------------------------------------------------------------------------
+
+namespace {
+
+// Writes a sweep file whose scene is the shipped source_dimensionless (absolute path).
+fs::path write_sweep(const fs::path& dir, const std::string& body, const std::string& name = "s.toml") {
+  const fs::path p = dir / name;
+  spit(p, body);
+  return p;
+}
+
+const std::string kGoodHead = "repeats = 1\nduration = 0.5\nscenes = [\"" + kScene + "\"]\n";
+const std::string kGoodSetup =
+    "[[setup]]\nname = \"ode\"\nengine = \"ode\"\nladder.key = \"engines.ode.timestep\"\n"
+    "ladder.values = [1e-3, 5e-4]\n";
+
+std::string load_error(const fs::path& p) {
+  try {
+    load_sweep(p.string());
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(SweepFiles, ShippedSweepsLoad) {
+  const SweepPlan smoke = load_sweep(kSmoke);
+  EXPECT_GE(smoke.points.size(), 6u);
+  const SweepPlan def = load_sweep(kSource + "/harness/sweeps/default.toml");
+  std::set<std::string> engines, scenes;
+  size_t most_steps = 0;
+  bool analytic_ladder = false;
+  for (const SweepSetup& s : def.spec.setups) {
+    engines.insert(s.engine);
+    if (s.ladder_key.find("timestep") != std::string::npos) most_steps = std::max(most_steps, s.ladder_values.size());
+    analytic_ladder = analytic_ladder || (s.engine == "analytic" && s.ladder_key == "run.rtol");
+  }
+  for (const Scene& s : def.scenes) scenes.insert(s.name);
+  EXPECT_GE(engines.size(), 4u) << "three engines and the analytic model";
+  EXPECT_GE(most_steps, 6u);
+  EXPECT_TRUE(analytic_ladder);
+  EXPECT_TRUE(scenes.count("source_dimensionless") && scenes.count("toy_viscous"));
+  EXPECT_GE(def.spec.repeats, 1);
+  // Point ids are unique and stable.
+  std::set<std::string> ids;
+  for (const SweepPoint& p : def.points) ids.insert(p.id);
+  EXPECT_EQ(ids.size(), def.points.size());
+  EXPECT_EQ(load_sweep(kSource + "/harness/sweeps/default.toml").plan_hash, def.plan_hash);
+}
+
+TEST(SweepFiles, PointsCarryTheirOverrides) {
+  TempDir dir;
+  const fs::path p =
+      write_sweep(dir.path(), kGoodHead +
+                                  "[[setup]]\nname = \"mj\"\nengine = \"mujoco\"\n"
+                                  "set = [\"engines.mujoco.integrator=\\\"RK4\\\"\"]\n"
+                                  "ladder.key = \"engines.mujoco.iterations\"\nladder.values = [5, 50]\n");
+  const SweepPlan plan = load_sweep(p.string());
+  ASSERT_EQ(plan.points.size(), 2u);
+  const Scene& s = plan.points[1].scene;
+  EXPECT_EQ(s.run.duration, 0.5);
+  EXPECT_EQ(std::get<std::string>(s.engines.at("mujoco").at("integrator")), "RK4");
+  EXPECT_EQ(std::get<long long>(s.engines.at("mujoco").at("iterations")), 50) << "integers stay integers";
+  EXPECT_NE(plan.points[0].id, plan.points[1].id);
+}
+
+TEST(SweepFiles, InvalidFilesNameFileAndKey) {
+  TempDir dir;
+  struct Case {
+    std::string body, key;
+  };
+  const std::vector<Case> cases = {
+      {kGoodHead + "repeat = 3\n" + kGoodSetup, ": repeat: unknown key"},
+      {"repeats = 0\nscenes = [\"" + kScene + "\"]\n" + kGoodSetup, ": repeats: must lie in [1, 100]"},
+      {"repeats = 2.5\nscenes = [\"" + kScene + "\"]\n" + kGoodSetup, ": repeats: expected an integer"},
+      {"duration = -1\nscenes = [\"" + kScene + "\"]\n" + kGoodSetup, ": duration: must be > 0"},
+      {"scenes = [\"nosuch.toml\"]\n" + kGoodSetup, ": scenes[0]: cannot read"},
+      {"scenes = []\n" + kGoodSetup, ": scenes: must list at least one scene"},
+      {kGoodHead, ": setup: missing"},
+      {kGoodHead + "[[setup]]\nname = \"x\"\nengine = \"havok\"\nladder.key = \"k\"\nladder.values = [1]\n",
+       ": setup[0].engine: unknown engine \"havok\""},
+      {kGoodHead + kGoodSetup + kGoodSetup, ": setup[1].name: \"ode\" is already the name of setup[0]"},
+      {kGoodHead + "[[setup]]\nname = \"x\"\nengine = \"ode\"\nladder.key = \"engines.ode.timestep\"\n"
+                   "ladder.values = [1e-3, 0.5]\n",
+       ": setup[0].ladder.values[1]: engines.ode.timestep: value 0.5 outside"},
+      {kGoodHead + "[[setup]]\nname = \"x\"\nengine = \"ode\"\nladder.key = \"engines.ode.timestep\"\n"
+                   "ladder.values = [\"1e-3\"]\n",
+       ": setup[0].ladder.values[0]: expected a number, got a string"},
+      {kGoodHead + "[[setup]]\nname = \"x\"\nengine = \"ode\"\nset = [\"engines.ode.nosuch=1\"]\n"
+                   "ladder.key = \"engines.ode.timestep\"\nladder.values = [1e-3]\n",
+       ": setup[0].set[0]: engines.ode.nosuch: unknown setting"},
+      {kGoodHead + "[[setup]]\nname = \"x\"\nengine = \"ode\"\nset = [\"contact.k=2\"]\n"
+                   "ladder.key = \"engines.ode.timestep\"\nladder.values = [1e-3]\n",
+       ": setup[0].set[0]: \"contact.k\" is not a setting of ode"},
+      {kGoodHead +
+           "[[setup]]\nname = \"x\"\nengine = \"analytic\"\nladder.key = \"run.duration\"\nladder.values = [1]\n",
+       ": setup[0].ladder.key: \"run.duration\" is not a setting of the analytic model"},
+      {kGoodHead + "[[setup]]\nname = \"x\"\nengine = \"ode\"\nladder.key = \"engines.ode.timestep\"\n"
+                   "ladder.values = [1e-3, 1e-3]\n",
+       ": setup[0].ladder.values[1]: 0.001 repeats setup[0].ladder.values[0]"},
+      {kGoodHead +
+           "[[setup]]\nname = \"x\"\nengine = \"ode\"\nladder = { key = \"engines.ode.timestep\", values = [1e-3], "
+           "step = 2 }\n",
+       ": setup[0].ladder.step: unknown key"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const fs::path p = write_sweep(dir.path(), cases[i].body, "case" + std::to_string(i) + ".toml");
+    const std::string msg = load_error(p);
+    EXPECT_EQ(msg.rfind(p.string() + ":", 0), 0u) << "case " << i << ": " << msg;
+    EXPECT_NE(msg.find(cases[i].key), std::string::npos) << "case " << i << ": " << msg;
+  }
+  const fs::path syntax = write_sweep(dir.path(), "repeats = = 3\n", "syntax.toml");
+  EXPECT_EQ(load_error(syntax).rfind(syntax.string() + ":1:", 0), 0u) << load_error(syntax);
+}
+
+// ---- the command ------------------------------------------------------------------------------
+
+namespace {
+
+struct Exit {
+  int code = -1;  // exit status, or -1 when killed
+  int signal = 0;
+};
+
+// Starts `tippe ARGS` with stderr to err_file, stdout to /dev/null.
+pid_t start_tippe(const std::vector<std::string>& args, const fs::path& err_file) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int err = ::open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(err, 2);
+    ::dup2(null, 1);
+    std::vector<char*> argv;
+    argv.push_back(const_cast<char*>(kBinary.c_str()));
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(kBinary.c_str(), argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+Exit wait_tippe(pid_t pid) {
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  Exit e;
+  if (WIFEXITED(status)) e.code = WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) e.signal = WTERMSIG(status);
+  return e;
+}
+
+Exit run_tippe(const std::vector<std::string>& args, const fs::path& err_file) {
+  return wait_tippe(start_tippe(args, err_file));
+}
+
+size_t count_lines(const fs::path& p) {
+  const std::string t = slurp(p);
+  return static_cast<size_t>(std::count(t.begin(), t.end(), '\n'));
+}
+
+// A record without what depends on the machine's load: timings and the cost ratio.
+json without_timings(const SweepRecord& r) {
+  json j = to_json(r);
+  j.erase("work");
+  for (const char* k : {"cpu_seconds", "wall_seconds", "real_time_factor", "cost_ratio"}) j["metrics"].erase(k);
+  j["steps"] = r.steps;
+  j["rhs_evaluations"] = r.rhs_evaluations;
+  j["solver_iterations"] = r.solver_iterations;
+  return j;
+}
+
+std::map<std::string, json> by_id(const std::vector<SweepRecord>& records, size_t& duplicates) {
+  std::map<std::string, json> m;
+  duplicates = 0;
+  for (const SweepRecord& r : records) duplicates += !m.emplace(r.point_id, without_timings(r)).second;
+  return m;
+}
+
+}  // namespace
+
+TEST(SweepCli, KilledSweepResumesToTheSameRecords) {
+  ASSERT_TRUE(fs::exists(kBinary)) << "build the tippe target first";
+  TempDir dir;
+  const fs::path whole = dir.path() / "whole", killed = dir.path() / "killed", err = dir.path() / "err.txt";
+  const size_t n_points = load_sweep(kSmoke).points.size();
+
+  // Uninterrupted.
+  Exit e = run_tippe({"sweep", kSmoke, "--out", whole.string(), "--jobs", "2", "--no-plots"}, err);
+  ASSERT_EQ(e.code, 0) << slurp(err);
+  size_t dup = 0;
+  const auto reference = by_id(read_records((whole / "records.jsonl").string()).records, dup);
+  ASSERT_EQ(reference.size(), n_points);
+  ASSERT_EQ(dup, 0u);
+
+  // Killed as soon as the first point is on disk, then a crash mid-write simulated by a partial line.
+  const std::vector<std::string> args = {"sweep", kSmoke, "--out", killed.string(), "--jobs", "1", "--no-plots"};
+  const pid_t pid = start_tippe(args, err);
+  const fs::path records = killed / "records.jsonl";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (count_lines(records) < 1 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ::kill(pid, SIGKILL);
+  e = wait_tippe(pid);
+  ASSERT_EQ(e.signal, SIGKILL) << "the sweep finished before it could be killed: " << slurp(err);
+  const size_t before = count_lines(records);
+  ASSERT_GE(before, 1u);
+  ASSERT_LT(before, n_points) << "killed midway";
+  {
+    std::ofstream out(records, std::ios::app | std::ios::binary);
+    out << to_jsonl(read_records(records.string()).records.front()).substr(0, 80);
+  }
+
+  // Restarted with the same command: completes, drops the partial line, loses and repeats nothing.
+  e = run_tippe(args, err);
+  ASSERT_EQ(e.code, 0) << slurp(err);
+  EXPECT_NE(slurp(err).find("partial last line"), std::string::npos) << slurp(err);
+  const std::string text = slurp(records);
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n');
+  const auto resumed = by_id(read_records(records.string()).records, dup);
+  EXPECT_EQ(dup, 0u);
+  ASSERT_EQ(resumed.size(), n_points);
+  for (const auto& [id, j] : reference) {
+    ASSERT_TRUE(resumed.count(id)) << id;
+    EXPECT_EQ(resumed.at(id), j) << id;
+  }
+
+  // A third run has nothing left to do and leaves the records alone.
+  e = run_tippe(args, err);
+  ASSERT_EQ(e.code, 0) << slurp(err);
+  EXPECT_EQ(slurp(records), text);
+
+  // The report is a function of the records: rebuilt from them, it is the same page.
+  const std::string md = slurp(killed / "report.md");
+  fs::remove(killed / "report.md");
+  fs::remove(killed / "index.html");
+  e = run_tippe({"sweep", "--report", killed.string(), "--no-plots"}, err);
+  ASSERT_EQ(e.code, 0) << slurp(err);
+  EXPECT_EQ(slurp(killed / "report.md"), md);
+  EXPECT_TRUE(fs::exists(killed / "index.html"));
+  EXPECT_NE(md.find("Cheapest setting of each engine"), std::string::npos);
+  EXPECT_NE(md.find("Regime: does it still roll?"), std::string::npos) << "the smoke sweep's toy scene rolls";
+}
+
+TEST(SweepCli, ChangedSweepFileIsRefusedUnlessRestarted) {
+  TempDir dir;
+  const fs::path out = dir.path() / "out", err = dir.path() / "err.txt";
+  const std::string body = kGoodHead + kGoodSetup;
+  const fs::path sweep = write_sweep(dir.path(), body);
+  Exit e = run_tippe({"sweep", sweep.string(), "--out", out.string(), "--jobs", "2", "--no-plots"}, err);
+  ASSERT_EQ(e.code, 0) << slurp(err);
+  ASSERT_EQ(count_lines(out / "records.jsonl"), 2u);
+  EXPECT_TRUE(fs::exists(out / "sweep.json"));
+  EXPECT_EQ(fs::directory_iterator(out / "reference") != fs::directory_iterator(), true) << "reference cached";
+
+  write_sweep(dir.path(), body + "# edited\n");
+  e = run_tippe({"sweep", sweep.string(), "--out", out.string(), "--no-plots"}, err);
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(slurp(err).find("sweep.json: sweep_hash:"), std::string::npos) << slurp(err);
+  EXPECT_EQ(count_lines(out / "records.jsonl"), 2u);
+
+  e = run_tippe({"sweep", sweep.string(), "--out", out.string(), "--restart", "--no-plots"}, err);
+  ASSERT_EQ(e.code, 0) << slurp(err);
+  EXPECT_EQ(count_lines(out / "records.jsonl"), 2u);
+  EXPECT_TRUE(fs::exists(out / "records.jsonl.old")) << "earlier records are kept aside";
+}
+
+TEST(SweepCli, InvalidSweepExitsWithTwoAndWritesNothing) {
+  TempDir dir;
+  const fs::path out = dir.path() / "out", err = dir.path() / "err.txt";
+  const fs::path bad =
+      write_sweep(dir.path(), kGoodHead +
+                                  "[[setup]]\nname = \"mj\"\nengine = \"mujoco\"\n"
+                                  "ladder.key = \"engines.mujoco.timestep\"\nladder.values = [1e-3, 2.0]\n");
+  Exit e = run_tippe({"sweep", bad.string(), "--out", out.string()}, err);
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(slurp(err).find(bad.string() + ": setup[0].ladder.values[1]: engines.mujoco.timestep"), std::string::npos)
+      << slurp(err);
+  EXPECT_FALSE(fs::exists(out));
+
+  const fs::path missing = write_sweep(dir.path(), "scenes = [\"gone.toml\"]\n" + kGoodSetup, "missing.toml");
+  e = run_tippe({"sweep", missing.string(), "--out", out.string()}, err);
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(slurp(err).find(missing.string() + ": scenes[0]:"), std::string::npos) << slurp(err);
+  EXPECT_FALSE(fs::exists(out));
+
+  e = run_tippe({"sweep", (dir.path() / "nosuch.toml").string(), "--out", out.string()}, err);
+  EXPECT_EQ(e.code, 2);
+  EXPECT_FALSE(fs::exists(out));
+  e = run_tippe({"sweep", "--report", (dir.path() / "nothing").string()}, err);
+  EXPECT_EQ(e.code, 2);
+  e = run_tippe({"sweep", "--jobs", "0", kSmoke, "--out", out.string()}, err);
+  EXPECT_EQ(e.code, 2);
+  EXPECT_FALSE(fs::exists(out));
+}
