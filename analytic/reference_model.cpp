@@ -243,7 +243,10 @@ struct ReferenceModel::Impl {
         ++owner.rhs_evals_;
       }
     }
-    const auto [t0, t1] = stepper.do_step(system);
+    // Plain names, not a structured binding: the lambda below captures them, which C++17
+    // allows only for variables (clang rejects capturing a binding; g++ accepts it).
+    const auto step_span = stepper.do_step(system);
+    const double t0 = step_span.first, t1 = step_span.second;
     ++owner.steps_;
     dt_hint = stepper.current_time_step();
     const StateVector y1 = stepper.current_state();

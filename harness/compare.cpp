@@ -274,7 +274,7 @@ Metrics metrics_from_json(const json& j) {
   m.tilt_rms_error = get_number(j, "tilt_rms_error");
   m.energy_max_error = get_number(j, "energy_max_error");
   m.energy_final_ratio = get_number(j, "energy_final_ratio");
-  m.energy_gain_events = j.at("energy_gain_events").get<long long>();
+  m.energy_gain_events = json_integer(j, "energy_gain_events");
   m.energy_max_gain = get_number(j, "energy_max_gain");
   m.contact_path_rms_error = get_number(j, "contact_path_rms_error");
   m.contact_path_max_error = get_number(j, "contact_path_max_error");
@@ -287,7 +287,7 @@ Metrics metrics_from_json(const json& j) {
   m.wall_seconds = get_number(j, "wall_seconds");
   m.cpu_seconds = get_number(j, "cpu_seconds");
   m.real_time_factor = get_number(j, "real_time_factor");
-  m.steps = j.at("steps").get<long long>();
+  m.steps = json_integer(j, "steps");
   m.cost_ratio = get_number(j, "cost_ratio");
   m.compared_until = get_number(j, "compared_until");
   return m;

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
@@ -223,6 +224,17 @@ json to_json(const RunRecord& r) {
   };
 }
 
+long long json_integer(const json& j, const char* key) {
+  const json& v = j.at(key);
+  if (!v.is_number_integer())
+    throw json::type_error::create(302, std::string(key) + ": expected an integer, got " +
+                                            (v.is_number_float() ? "a float" : v.type_name()), &v);
+  if (v.is_number_unsigned() &&
+      v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<long long>::max()))
+    throw json::out_of_range::create(406, std::string(key) + ": " + v.dump() + " is out of range", &v);
+  return v.get<long long>();
+}
+
 RunRecord from_json(const json& j) {
   RunRecord r;
   r.scene_name = j.at("scene").get<std::string>();
@@ -236,7 +248,7 @@ RunRecord from_json(const json& j) {
   r.status_detail = j.at("status_detail").get<std::string>();
   r.inversion_time = get_optional(j, "inversion_time");
   r.stem_contact_time = get_optional(j, "stem_contact_time");
-  r.samples = j.at("samples").get<long long>();
+  r.samples = json_integer(j, "samples");
   r.final_time = get_number(j, "final_time");
   r.final_tilt = get_number(j, "final_tilt");
   r.energy_initial = get_number(j, "energy_initial");
@@ -251,9 +263,9 @@ RunRecord from_json(const json& j) {
             get_number(m, "inertia_axial")};
   r.inversion_possible = j.at("inversion_possible").get<bool>();
   const json& w = j.at("work");
-  r.work.steps = w.at("steps").get<long long>();
-  r.work.rhs_evaluations = w.at("rhs_evaluations").get<long long>();
-  r.work.solver_iterations = w.at("solver_iterations").get<long long>();
+  r.work.steps = json_integer(w, "steps");
+  r.work.rhs_evaluations = json_integer(w, "rhs_evaluations");
+  r.work.solver_iterations = json_integer(w, "solver_iterations");
   r.work.wall_seconds = get_number(w, "wall_seconds");
   r.work.cpu_seconds = get_number(w, "cpu_seconds");
   for (const json& e : j.at("events"))

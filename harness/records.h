@@ -97,6 +97,11 @@ nlohmann::json to_json(const RunRecord& r);
 // Throws nlohmann::json::exception for a missing or mistyped field.
 RunRecord from_json(const nlohmann::json& j);
 
+// An integer field of a record (counts of samples, steps, events): a JSON integer within the
+// range of long long. Throws nlohmann::json::exception for a missing field or any other value;
+// json::get<long long> would convert a float such as 1e300 with undefined behaviour.
+long long json_integer(const nlohmann::json& j, const char* key);
+
 // Writes `text` to `path.tmp.PID`, fsyncs it and renames it over `path`, so readers see the old
 // file or the new one, never a part. Throws std::runtime_error (temporary removed) on failure.
 void write_file_atomic(const std::string& path, const std::string& text);

@@ -77,6 +77,36 @@ bool is_bare_key(const std::string& s) {
   });
 }
 
+// Well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF). What
+// toml++ enforces on a document, checked here on the text that does not pass through it.
+bool is_utf8(const std::string& s) {
+  size_t i = 0;
+  const size_t n = s.size();
+  while (i < n) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    size_t len;
+    unsigned lo = 0x80, hi = 0xBF;  // range of the second byte
+    if (c < 0x80) len = 1;
+    else if (c >= 0xC2 && c <= 0xDF) len = 2;
+    else if (c >= 0xE0 && c <= 0xEF) {
+      len = 3;
+      if (c == 0xE0) lo = 0xA0;
+      if (c == 0xED) hi = 0x9F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      len = 4;
+      if (c == 0xF0) lo = 0x90;
+      if (c == 0xF4) hi = 0x8F;
+    } else return false;
+    if (n - i < len) return false;
+    for (size_t k = 1; k < len; ++k) {
+      const auto b = static_cast<unsigned char>(s[i + k]);
+      if (k == 1 ? (b < lo || b > hi) : (b < 0x80 || b > 0xBF)) return false;
+    }
+    i += len;
+  }
+  return true;
+}
+
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t");
   if (b == std::string::npos) return {};
@@ -115,6 +145,9 @@ class Interpreter {
     } catch (const toml::parse_error&) {
     }
     if (!is_toml) {
+      // A bare word becomes a TOML string, which must be UTF-8; the run's records are JSON,
+      // whose writer would otherwise throw only after the whole run.
+      if (!is_utf8(value_text)) fail("--set", "the value of " + key + " is not valid UTF-8");
       parsed = toml::table{};
       parsed.insert("v", value_text);
     }
@@ -449,23 +482,28 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   std::ostringstream bytes;
   bytes << in.rdbuf();
   if (in.bad()) throw SceneError(path + ": cannot read: " + std::strerror(errno));
-  const std::string text = bytes.str();
+  return parse_scene_text(bytes.str(), path, overrides);
+}
 
+Scene parse_scene_text(const std::string& text, const std::string& file_label,
+                       const std::vector<std::string>& overrides) {
+  // The label is the scene's source_file in every JSON record: checked before any work is done.
+  if (!is_utf8(file_label)) throw SceneError(file_label + ": cannot read: the path is not valid UTF-8");
   toml::table root;
   try {
-    root = toml::parse(text, path);
+    root = toml::parse(text, file_label);
   } catch (const toml::parse_error& e) {
-    throw SceneError(path + ":" + std::to_string(e.source().begin.line) + ":" +
+    throw SceneError(file_label + ":" + std::to_string(e.source().begin.line) + ":" +
                      std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
   }
 
   std::set<std::string> overridden;
   for (const auto& o : overrides) overridden.insert(trim(o.substr(0, o.find('='))));
-  Interpreter interp(path, overridden);
+  Interpreter interp(file_label, overridden);
   for (const auto& o : overrides) interp.apply_override(root, o);
 
-  Scene s = interp.interpret(root, std::filesystem::path(path).stem().string());
-  s.source_file = path;
+  Scene s = interp.interpret(root, std::filesystem::path(file_label).stem().string());
+  s.source_file = file_label;
   s.content_hash = fnv1a64_hex(text, overrides);
   return s;
 }

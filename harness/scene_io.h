@@ -48,9 +48,18 @@ class SceneError : public std::runtime_error {
 //  - [engines.NAME] tables are copied into Scene::engines (bool, integer -> long long,
 //    float -> double, string, array of numbers -> vector<double>) and checked with
 //    validate_engine_settings.
+// A path that is not valid UTF-8, and a --set value that is not valid UTF-8 and not a TOML value,
+// are rejected: records are JSON.
 // Scene::content_hash is FNV-1a 64 (16 hex digits) over the file's bytes and the overrides;
 // Scene::source_file is `path` as given.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// What load_scene does once it has the file's bytes: `text` is parsed and checked as above,
+// `file_label` takes the place of the path in messages, the default name (its stem) and
+// Scene::source_file. Touches no file; SceneError is the only exception it throws for any
+// input (the fuzz target tests/fuzz/fuzz_scene.cpp holds it to that).
+Scene parse_scene_text(const std::string& text, const std::string& file_label,
+                       const std::vector<std::string>& overrides = {});
 
 // Every field of a scene, its mass properties and engine tables, for run records.
 nlohmann::json scene_to_json(const Scene& scene);
