@@ -79,9 +79,11 @@ double jellett(const BodyModel& m, const BodyState& x, Surface s) {
   return L_B.dot(R_C_B);
 }
 
+// atan2 rather than acos of e_Z.z: acos loses all digits near 0 and pi (a tilt of 1e-9 rad
+// has cos = 1 - 5e-19, which rounds to 1), and the extremes start that close to vertical.
 double tilt(const Quat& q_WB) {
-  const double c = std::clamp((q_WB * Vec3::UnitZ()).z(), -1.0, 1.0);
-  return std::acos(c);
+  const Vec3 e_Z = q_WB * Vec3::UnitZ();
+  return std::atan2(std::hypot(e_Z.x(), e_Z.y()), e_Z.z());
 }
 
 Observation observe_kinematics(const BodyModel& m, const BodyState& x) {
@@ -99,7 +101,7 @@ Observation observe_kinematics(const BodyModel& m, const BodyState& x) {
   o.jellett = jellett(m, x, low);
   // Latitude of the ball point under O measured from the south pole -e_Z.
   const Vec3 down_B = x.q_WB.conjugate() * (-Vec3::UnitZ());
-  o.contact_latitude = std::acos(std::clamp(-down_B.z(), -1.0, 1.0));
+  o.contact_latitude = std::atan2(std::hypot(down_B.x(), down_B.y()), -down_B.z());
   return o;
 }
 

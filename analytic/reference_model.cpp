@@ -1,5 +1,6 @@
-// The analytic reference: Dormand-Prince 5(4) with dense output, events located by TOMS 748 root
-// finding on the dense output, mode changes (impacts, stick/slip, release) applied at the event.
+// The analytic reference: adaptive integration with dense output (Bulirsch-Stoer, Dormand-Prince
+// 5(4) or Rosenbrock4), events located by TOMS 748 root finding on the dense output, mode
+// changes (impacts, stick/slip, release) applied at the event.
 #include "reference_model.h"
 
 #include <boost/math/tools/toms748_solve.hpp>
@@ -7,7 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <sstream>
+#include <tuple>
 
 #include "initial_state.h"
 
@@ -20,7 +23,7 @@ namespace {
 using Dopri = odeint::runge_kutta_dopri5<StateVector>;
 using System = std::function<void(const StateVector&, StateVector&, double)>;
 
-// The two dense-output steppers behind one interface, so that the method is a run setting.
+// The dense-output steppers behind one interface, so that the method is a run setting.
 struct DenseStepper {
   virtual ~DenseStepper() = default;
   virtual void initialize(const StateVector& y, double t, double dt) = 0;
@@ -43,8 +46,103 @@ struct DenseStepperOf final : DenseStepper {
   S stepper;
 };
 
+// Rosenbrock4 (L-stable, order 4, dense output of order 3) for stiff runs: the viscous law's
+// slip relaxes at the rate ~k/M, which limits the explicit methods' step to ~M/k however
+// smooth the motion. Boost's stepper works on ublas vectors; this converts at the interface.
+class RosenbrockStepper final : public DenseStepper {
+ public:
+  using UVector = boost::numeric::ublas::vector<double>;
+  using UMatrix = boost::numeric::ublas::matrix<double>;
+  using Stepper = odeint::rosenbrock4_dense_output<odeint::rosenbrock4_controller<odeint::rosenbrock4<double>>>;
+
+  RosenbrockStepper(double atol, double rtol, double max_dt)
+      : stepper_(odeint::rosenbrock4_controller<odeint::rosenbrock4<double>>(atol, rtol, max_dt)), u_(kN), jac_(kN, kN) {}
+
+  void initialize(const StateVector& y, double t, double dt) override {
+    to_ublas(y, u_);
+    stepper_.initialize(u_, t, dt);
+    y_ = y;
+  }
+
+  std::pair<double, double> do_step(const System& sys) override {
+    auto rhs = [&](const UVector& x, UVector& dxdt, double t) {
+      StateVector xs, fs;
+      from_ublas(x, xs);
+      sys(xs, fs, t);
+      to_ublas(fs, dxdt);
+    };
+    // The controller retries a rejected step from the same state, in the same mode: the
+    // Jacobian is kept for those retries.
+    bool have_jac = false;
+    StateVector x_jac{};
+    auto jacobian = [&](const UVector& x, UMatrix& J, const double& t, UVector& dfdt) {
+      // The right-hand side does not depend on t (an autonomous system).
+      for (size_t i = 0; i < kN; ++i) dfdt[i] = 0.0;
+      StateVector x0;
+      from_ublas(x, x0);
+      if (!have_jac || x0 != x_jac) {
+        fill_jacobian(sys, x0, t, jac_);
+        x_jac = x0;
+        have_jac = true;
+      }
+      J = jac_;
+    };
+    const auto span = stepper_.do_step(std::make_pair(rhs, jacobian));
+    from_ublas(stepper_.current_state(), y_);
+    return span;
+  }
+
+  void calc_state(double t, StateVector& y) override {
+    stepper_.calc_state(t, u_);
+    from_ublas(u_, y);
+  }
+  const StateVector& current_state() const override { return y_; }
+  double current_time() const override { return stepper_.current_time(); }
+  double current_time_step() const override { return stepper_.current_time_step(); }
+
+ private:
+  static constexpr size_t kN = std::tuple_size<StateVector>::value;
+
+  // Central differences, h_j = cbrt(eps) * scale_j: truncation O(h^2) balances round-off
+  // O(eps / h), so J is right to ~1e-10 relative. Forward differences (~1e-8) do not do: the
+  // embedded error estimate uses the same J, so an error in J escapes the step control (it
+  // made the tilt error 50x larger at rtol 1e-10). scale_j is the larger of |y_j| and the norm
+  // of its group (p, v, q, omega; 1 if that is 0), so a zero component is not perturbed at
+  // the scale of round-off.
+  static void fill_jacobian(const System& sys, const StateVector& x0, double t, UMatrix& J) {
+    static constexpr size_t kGroups[5] = {0, 3, 6, 10, kN};
+    const double cbrt_eps = std::cbrt(std::numeric_limits<double>::epsilon());
+    for (int grp = 0; grp < 4; ++grp) {
+      double norm = 0.0;
+      for (size_t i = kGroups[grp]; i < kGroups[grp + 1]; ++i) norm += x0[i] * x0[i];
+      norm = std::sqrt(norm);
+      for (size_t j = kGroups[grp]; j < kGroups[grp + 1]; ++j) {
+        const double scale = std::max({std::abs(x0[j]), norm, norm > 0 ? 0.0 : 1.0});
+        StateVector xp = x0, xm = x0, fp, fm;
+        xp[j] = x0[j] + cbrt_eps * scale;
+        const double h = xp[j] - x0[j];  // the step as represented
+        xm[j] = x0[j] - h;
+        sys(xp, fp, t);
+        sys(xm, fm, t);
+        for (size_t i = 0; i < kN; ++i) J(i, j) = (fp[i] - fm[i]) / (2 * h);
+      }
+    }
+  }
+  static void to_ublas(const StateVector& y, UVector& u) {
+    for (size_t i = 0; i < kN; ++i) u[i] = y[i];
+  }
+  static void from_ublas(const UVector& u, StateVector& y) {
+    for (size_t i = 0; i < kN; ++i) y[i] = u[i];
+  }
+  Stepper stepper_;
+  UVector u_;  // scratch for calc_state and initialize
+  UMatrix jac_;
+  StateVector y_{};
+};
+
 std::unique_ptr<DenseStepper> make_stepper(const RunSpec& run) {
   const double max_dt = run.duration / 64.0;
+  if (run.method == "rosenbrock4") return std::make_unique<RosenbrockStepper>(run.atol, run.rtol, max_dt);
   if (run.method == "dopri5") {
     auto s = odeint::make_dense_output(run.atol, run.rtol, max_dt, Dopri());
     return std::make_unique<DenseStepperOf<decltype(s)>>(std::move(s));
@@ -96,6 +194,7 @@ struct ReferenceModel::Impl {
   bool stem_touched = false;
   double v_eps = 0.0, slip_eps = 0.0;
   double dt_hint = 0.0;
+  std::string failure_hint;  // appended to a "non-finite state" failure: what to try instead
   long long events_in_burst = 0;
   System system;
   double burst_start = -1.0;
@@ -577,6 +676,17 @@ ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene
   impl_->slip_eps = std::max(1e-7, 10.0 * scene.run.rtol) * v_scale;
   const double period = std::min(2 * M_PI / std::max(x0.w_B.norm(), 1e-9), std::sqrt(body_.R / body_.g));
   impl_->dt_hint = 1e-3 * period;
+  if (scene.contact.friction == FrictionLaw::Viscous && scene.contact.k > 0 && scene.run.method != "rosenbrock4") {
+    // The slip of a viscous contact relaxes in about M/k; far below the motion's own time scale
+    // an explicit method's step is bounded by it, and it can blow up on the first step.
+    const double relax = body_.M / scene.contact.k;
+    if (relax < 1e-3 * period) {
+      std::ostringstream os;
+      os << " (the viscous slip relaxes in M/k = " << relax << ", " << period / relax
+         << " times faster than the motion: stiff for " << scene.run.method << "; run.method = \"rosenbrock4\" is made for it)";
+      impl_->failure_hint = os.str();
+    }
+  }
   const StateVector y0 = pack(x0);
   ContactMode none;
   impl_->y_obs = y0;
@@ -612,7 +722,7 @@ void ReferenceModel::advance_to(double t) {
     const StateVector& y = m.stepper.current_state();
     for (double v : y)
       if (!std::isfinite(v)) {
-        m.end(ReferenceStatus::Failed, m.stepper.current_time(), "non-finite state", y);
+        m.end(ReferenceStatus::Failed, m.stepper.current_time(), "non-finite state" + m.failure_hint, y);
         return;
       }
   }

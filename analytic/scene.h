@@ -60,8 +60,9 @@ struct RunSpec {
   double sample_interval = 1e-3;
   double rtol = 1e-10;
   double atol = 1e-12;
-  // Reference integrator: "bulirsch_stoer" (extrapolation, high order: the default) or "dopri5"
-  // (Dormand-Prince 5(4)); both with dense output for event location.
+  // Reference integrator: "bulirsch_stoer" (extrapolation, high order: the default), "dopri5"
+  // (Dormand-Prince 5(4)) or "rosenbrock4" (linearly implicit, order 4, for stiff runs such as
+  // the viscous law at large k); all with dense output for event location.
   std::string method = "bulirsch_stoer";
 };
 
