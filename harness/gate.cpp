@@ -18,6 +18,7 @@
 #include <toml++/toml.h>
 
 #include "scene_io.h"
+#include "toml_text.h"
 
 namespace tippe {
 
@@ -27,22 +28,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 // ---- small helpers ----------------------------------------------------------------------------
-
-const char* type_name(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::none: return "nothing";
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-  }
-  return "?";
-}
 
 // Short enough for a CI log, long enough that a value just over its threshold does not print
 // equal to it; integral values (steps, counts) print without an exponent.
@@ -133,6 +118,11 @@ class GateReader {
     throw SceneError(file_ + ": " + key + ": " + why);
   }
 
+  // The one form of every range error, as in scene files: "KEY: VALUE is out of range (expected RANGE)".
+  [[noreturn]] void out_of_range(const std::string& key, double v, const std::string& expected) const {
+    fail(key, fmt(v) + " is out of range (expected " + expected + ")");
+  }
+
   void keys(const toml::table& t, const std::string& prefix, const std::vector<std::string>& allowed) const {
     for (auto&& [k, v] : t) {
       (void)v;
@@ -144,7 +134,7 @@ class GateReader {
 
   std::string string(const toml::node& n, const std::string& key) const {
     const auto* s = n.as_string();
-    if (!s) fail(key, std::string("expected a string, got ") + type_name(n));
+    if (!s) fail(key, "expected a string, got " + toml_value_text(n));
     return s->get();
   }
 
@@ -152,9 +142,8 @@ class GateReader {
     double v;
     if (const auto* f = n.as_floating_point()) v = f->get();
     else if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
-    else fail(key, std::string("expected a number, got ") + type_name(n));
-    if (std::isnan(v)) fail(key, "must be a number, got nan");
-    if (!std::isfinite(v)) fail(key, "must be finite, got " + fmt(v));
+    else fail(key, "expected a number, got " + toml_value_text(n));
+    if (!std::isfinite(v)) fail(key, "must be a finite number, got " + fmt(v));
     return v;
   }
 
@@ -189,16 +178,16 @@ class GateReader {
     }
     if (const toml::node* n = t.get("require_same_events")) {
       const auto* b = n->as_boolean();
-      if (!b) fail(key + ".require_same_events", std::string("expected true or false, got ") + type_name(*n));
+      if (!b) fail(key + ".require_same_events", "expected true or false, got " + toml_value_text(*n));
       s.require_same_events = b->get();
     }
     if (const toml::node* n = t.get("duration")) {
       s.duration = number(*n, key + ".duration");
-      if (!(*s.duration > 0)) fail(key + ".duration", "must be > 0, got " + fmt(*s.duration));
+      if (!(*s.duration > 0)) out_of_range(key + ".duration", *s.duration, "duration > 0");
     }
     if (const toml::node* n = t.get("set")) {
       const auto* a = n->as_array();
-      if (!a) fail(key + ".set", std::string("expected an array of \"KEY=VALUE\" strings, got ") + type_name(*n));
+      if (!a) fail(key + ".set", "expected an array of \"KEY=VALUE\" strings, got " + toml_value_text(*n));
       std::vector<std::string> set;
       std::set<std::string> seen;
       for (size_t j = 0; j < a->size(); ++j) {
@@ -214,7 +203,7 @@ class GateReader {
     }
     if (const toml::node* n = t.get("max")) {
       const auto* m = n->as_table();
-      if (!m) fail(key + ".max", std::string("expected a table of metric = threshold, got ") + type_name(*n));
+      if (!m) fail(key + ".max", "expected a table of metric = threshold, got " + toml_value_text(*n));
       for (auto&& [k, v] : *m) {
         const std::string metric(k.str());
         const std::string mk = key + ".max." + metric;
@@ -226,7 +215,9 @@ class GateReader {
           fail(mk, "unknown metric (expected one of: " + join(names, ", ") + ")");
         }
         const double x = number(v, mk);
-        if (x < 0) fail(mk, "must be >= 0 (|value| is compared), got " + fmt(x));
+        // No upper bound: metrics differ in unit and scale (steps, seconds, ratios), and a loose
+        // threshold is a visible choice of the gate's author, not a typo that hides a failure.
+        if (x < 0) out_of_range(mk, x, metric + " >= 0: |value| is compared");
         s.max[metric] = x;
       }
     }
@@ -313,13 +304,13 @@ GateFile load_gate_file(const std::string& path) {
   defaults.key = "defaults";
   if (const toml::node* d = root.get("defaults")) {
     const auto* t = d->as_table();
-    if (!t) reader.fail("defaults", std::string("expected a table, got ") + type_name(*d));
+    if (!t) reader.fail("defaults", "expected a table, got " + toml_value_text(*d));
     defaults = reader.spec(*t, "defaults", true);
   }
   const toml::node* cn = root.get("check");
   if (!cn) reader.fail("check", "no checks (a gate file needs one or more [[check]] tables)");
   const auto* checks = cn->as_array();
-  if (!checks) reader.fail("check", std::string("expected [[check]] tables, got ") + type_name(*cn));
+  if (!checks) reader.fail("check", "expected [[check]] tables, got " + toml_value_text(*cn));
   if (checks->empty()) reader.fail("check", "no checks (a gate file needs one or more [[check]] tables)");
 
   GateFile g;
@@ -330,7 +321,7 @@ GateFile load_gate_file(const std::string& path) {
     const std::string key = idx("check", i);
     const toml::node& n = *checks->get(i);
     const auto* t = n.as_table();
-    if (!t) reader.fail(key, std::string("expected a [[check]] table, got ") + type_name(n));
+    if (!t) reader.fail(key, "expected a [[check]] table, got " + toml_value_text(n));
     const Spec s = reader.spec(*t, key, false);
 
     Check c;

@@ -1,5 +1,6 @@
 // Scene files: TOML -> Scene with every key checked, command-line overrides, and Scene -> JSON.
 #include "scene_io.h"
+#include "toml_text.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -26,6 +27,11 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 // A guard against a typo in sample_interval producing a trajectory of many gigabytes.
 constexpr double kMaxSamples = 1e8;
+// Below a few machine epsilons (2.2e-16) the integrator's error estimate is rounding noise: no
+// step can meet the tolerance and the run only ends by failing.
+constexpr double kMinRtol = 1e-15;
+// Looser than 1 % the reference is no longer a reference.
+constexpr double kMaxRtol = 1e-2;
 
 std::string num(double v) {
   std::ostringstream os;
@@ -36,22 +42,6 @@ std::string num(double v) {
 
 std::string join_path(const std::string& prefix, const std::string& key) {
   return prefix.empty() ? key : prefix + "." + key;
-}
-
-const char* type_name(toml::node_type t) {
-  switch (t) {
-    case toml::node_type::none: return "nothing";
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-  }
-  return "?";
 }
 
 std::string fnv1a64_hex(const std::string& bytes, const std::vector<std::string>& overrides) {
@@ -124,6 +114,11 @@ class Interpreter {
     throw SceneError(file_ + ": " + key + ": " + why);
   }
 
+  // The one form of every range error: "KEY: VALUE is out of range (expected RANGE)".
+  [[noreturn]] void out_of_range(const std::string& key, double v, const std::string& expected) const {
+    fail(key, num(v) + " is out of range (expected " + expected + ")");
+  }
+
   void apply_override(toml::table& root, const std::string& text) const {
     const auto eq = text.find('=');
     const std::string key = trim(text.substr(0, eq));
@@ -175,7 +170,7 @@ class Interpreter {
     s.description = opt_string(root, "", "description").value_or("");
     if (s.description.find_first_of("\r\n") != std::string::npos) fail("description", "must be one line");
     s.gravity = need_number(root, "", "gravity");
-    if (!(s.gravity > 0)) fail("gravity", "must be > 0, got " + num(s.gravity));
+    if (!(s.gravity > 0)) out_of_range("gravity", s.gravity, "gravity > 0");
 
     // contact first: whether a stem exists decides which body keys are required.
     read_contact(need_table(root, "", "contact"), s.contact);
@@ -212,7 +207,7 @@ class Interpreter {
     const toml::node* n = t.get(key);
     if (!n) fail(join_path(prefix, key), "missing (required table)");
     const toml::table* tbl = n->as_table();
-    if (!tbl) fail(join_path(prefix, key), std::string("expected a table, got ") + type_name(n->type()));
+    if (!tbl) fail(join_path(prefix, key), "expected a table, got " + toml_value_text(*n));
     return *tbl;
   }
 
@@ -220,7 +215,7 @@ class Interpreter {
     double v;
     if (const auto* f = n.as_floating_point()) v = f->get();
     else if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
-    else fail(path, std::string("expected a number, got ") + type_name(n.type()));
+    else fail(path, "expected a number, got " + toml_value_text(n));
     if (!std::isfinite(v)) fail(path, "must be a finite number, got " + num(v));
     return v;
   }
@@ -239,7 +234,7 @@ class Interpreter {
 
   double need_positive(const toml::table& t, const std::string& prefix, const char* key) const {
     const double v = need_number(t, prefix, key);
-    if (!(v > 0)) fail(join_path(prefix, key), "must be > 0, got " + num(v));
+    if (!(v > 0)) out_of_range(join_path(prefix, key), v, std::string(key) + " > 0");
     return v;
   }
 
@@ -247,7 +242,7 @@ class Interpreter {
     const toml::node* n = t.get(key);
     if (!n) return std::nullopt;
     const auto* b = n->as_boolean();
-    if (!b) fail(join_path(prefix, key), std::string("expected true or false, got ") + type_name(n->type()));
+    if (!b) fail(join_path(prefix, key), "expected true or false, got " + toml_value_text(*n));
     return b->get();
   }
 
@@ -255,7 +250,7 @@ class Interpreter {
     const toml::node* n = t.get(key);
     if (!n) return std::nullopt;
     const auto* s = n->as_string();
-    if (!s) fail(join_path(prefix, key), std::string("expected a string, got ") + type_name(n->type()));
+    if (!s) fail(join_path(prefix, key), "expected a string, got " + toml_value_text(*n));
     return s->get();
   }
 
@@ -267,7 +262,7 @@ class Interpreter {
     const auto* a = n->as_array();
     if (!a || a->size() != count)
       fail(path, "expected an array of " + std::to_string(count) + " numbers, got " +
-                     (a ? "an array of " + std::to_string(a->size()) : std::string(type_name(n->type()))));
+                     (a ? "an array of " + std::to_string(a->size()) : toml_value_text(*n)));
     std::vector<double> out;
     for (size_t i = 0; i < a->size(); ++i) out.push_back(to_number(*a->get(i), path + "[" + std::to_string(i) + "]"));
     return out;
@@ -292,13 +287,14 @@ class Interpreter {
 
     if (c.friction == FrictionLaw::Coulomb) {
       c.mu = need_number(t, "contact", "mu");
-      if (!(c.mu >= 0)) fail("contact.mu", "must be >= 0, got " + num(c.mu));
+      // No upper bound on mu or k: large values are how a scene approaches rolling.
+      if (!(c.mu >= 0)) out_of_range("contact.mu", c.mu, "mu >= 0");
     } else {
       must_be_zero_if_present(t, "mu", law->c_str());
     }
     if (c.friction == FrictionLaw::Viscous) {
       c.k = need_number(t, "contact", "k");
-      if (!(c.k >= 0)) fail("contact.k", "must be >= 0, got " + num(c.k));
+      if (!(c.k >= 0)) out_of_range("contact.k", c.k, "k >= 0");
     } else {
       must_be_zero_if_present(t, "k", law->c_str());
     }
@@ -306,7 +302,7 @@ class Interpreter {
       must_be_zero_if_present(t, "drilling", law->c_str());
     } else {
       c.drilling = opt_number(t, "contact", "drilling").value_or(0.0);
-      if (!(c.drilling >= 0)) fail("contact.drilling", "must be >= 0, got " + num(c.drilling));
+      if (!(c.drilling >= 0)) out_of_range("contact.drilling", c.drilling, "drilling >= 0");
     }
     c.stem = opt_bool(t, "contact", "stem").value_or(true);
     c.flight = opt_bool(t, "contact", "flight").value_or(false);
@@ -326,10 +322,10 @@ class Interpreter {
       if (t.contains("stem_radius")) b.stem_radius = need_positive(t, "body", "stem_radius");
       if (t.contains("stem_length")) b.stem_length = need_positive(t, "body", "stem_length");
     }
-    b.truncation_height = need_positive(t, "body", "truncation_height");
-    if (b.truncation_height > b.sphere_radius)
-      fail("body.truncation_height", "must be <= sphere_radius (" + num(b.sphere_radius) + "), got " +
-                                         num(b.truncation_height));
+    b.truncation_height = need_number(t, "body", "truncation_height");
+    if (!(b.truncation_height > 0 && b.truncation_height <= b.sphere_radius))
+      out_of_range("body.truncation_height", b.truncation_height,
+                   "0 < truncation_height <= sphere_radius = " + num(b.sphere_radius));
     const auto problems = geometry_problems(b, s.contact.stem);
     if (!problems.empty()) throw SceneError(body_message(problems.front()));
 
@@ -347,11 +343,12 @@ class Interpreter {
       m.inertia_transverse = need_positive(t, "body", "inertia_transverse");
       m.inertia_axial = need_positive(t, "body", "inertia_axial");
       if (!(std::abs(m.com_offset) < b.sphere_radius))
-        fail("body.com_offset", "must lie in (-R, R) = (" + num(-b.sphere_radius) + ", " + num(b.sphere_radius) +
-                                    "), got " + num(m.com_offset));
+        out_of_range("body.com_offset", m.com_offset,
+                     "-R < com_offset < R, R = sphere_radius = " + num(b.sphere_radius));
       if (m.inertia_axial > 2 * m.inertia_transverse)
-        fail("body.inertia_axial", "C = " + num(m.inertia_axial) + " exceeds 2A = " + num(2 * m.inertia_transverse) +
-                                       " (triangle inequality of an axisymmetric body)");
+        out_of_range("body.inertia_axial", m.inertia_axial,
+                     "inertia_axial <= 2 inertia_transverse = " + num(2 * m.inertia_transverse) +
+                         ": the triangle inequality of an axisymmetric body");
       return;
     }
     if (given > 0) {
@@ -389,7 +386,7 @@ class Interpreter {
     keys(t, "initial", {"tilt", "spin", "omega", "velocity", "omega_along_contact", "height"});
     InitialSpec& in = s.initial;
     in.tilt = need_number(t, "initial", "tilt");
-    if (!(in.tilt >= 0 && in.tilt <= kPi)) fail("initial.tilt", "must lie in [0, pi] rad, got " + num(in.tilt));
+    if (!(in.tilt >= 0 && in.tilt <= kPi)) out_of_range("initial.tilt", in.tilt, "0 <= tilt <= pi = " + num(kPi) + " rad");
     const auto spin = opt_number(t, "initial", "spin");
     const auto omega = opt_numbers(t, "initial", "omega", 3);
     if (spin && omega) fail("initial.omega", "give either spin or omega, not both");
@@ -410,7 +407,7 @@ class Interpreter {
     if (in.omega_along_contact && in.omega_given)
       fail("initial.omega_along_contact", "takes its magnitude from spin; it cannot be combined with omega");
     in.height = opt_number(t, "initial", "height").value_or(0.0);
-    if (!(in.height >= 0)) fail("initial.height", "must be >= 0, got " + num(in.height));
+    if (!(in.height >= 0)) out_of_range("initial.height", in.height, "height >= 0");
     if (in.height > 0 && !s.contact.flight)
       fail("initial.height", "a start above the floor needs contact.flight = true");
   }
@@ -418,22 +415,27 @@ class Interpreter {
   void read_run(const toml::table& t, RunSpec& r) const {
     keys(t, "run", {"duration", "sample_interval", "rtol", "atol", "method"});
     r.duration = need_positive(t, "run", "duration");
-    r.sample_interval = need_positive(t, "run", "sample_interval");
-    if (r.sample_interval > r.duration)
-      fail("run.sample_interval", "must be <= duration (" + num(r.duration) + "), got " + num(r.sample_interval));
+    r.sample_interval = need_number(t, "run", "sample_interval");
+    if (!(r.sample_interval > 0 && r.sample_interval <= r.duration))
+      out_of_range("run.sample_interval", r.sample_interval, "0 < sample_interval <= duration = " + num(r.duration));
     if (r.duration / r.sample_interval > kMaxSamples)
-      fail("run.sample_interval", "gives " + num(r.duration / r.sample_interval) + " samples, more than " +
-                                      num(kMaxSamples));
+      fail("run.sample_interval", num(r.sample_interval) + " gives " + num(r.duration / r.sample_interval) +
+                                      " samples, more than " + num(kMaxSamples) +
+                                      " (expected sample_interval >= duration / " + num(kMaxSamples) + " = " +
+                                      num(r.duration / kMaxSamples) + ")");
     r.rtol = opt_number(t, "run", "rtol").value_or(r.rtol);
-    if (!(r.rtol > 0 && r.rtol <= 1e-2)) fail("run.rtol", "must lie in (0, 1e-2], got " + num(r.rtol));
+    if (!(r.rtol >= kMinRtol && r.rtol <= kMaxRtol))
+      out_of_range("run.rtol", r.rtol, num(kMinRtol) + " <= rtol <= " + num(kMaxRtol));
     r.atol = opt_number(t, "run", "atol").value_or(r.atol);
-    if (!(r.atol > 0 && r.atol <= 1)) fail("run.atol", "must lie in (0, 1], got " + num(r.atol));
+    // atol is in the scene's own units, so only its sign is certain; the bound of 1 is a
+    // judgement: it would swamp the states of every shipped scene (of order 1 or smaller).
+    if (!(r.atol > 0 && r.atol <= 1)) out_of_range("run.atol", r.atol, "0 < atol <= 1");
     if (const toml::node* m = t.get("method")) {
       const auto* str = m->as_string();
-      if (!str) fail("run.method", "expected a string");
+      if (!str) fail("run.method", "expected a string, got " + toml_value_text(*m));
       r.method = str->get();
-      if (r.method != "bulirsch_stoer" && r.method != "dopri5")
-        fail("run.method", "must be \"bulirsch_stoer\" or \"dopri5\", got \"" + r.method + "\"");
+      if (r.method != "bulirsch_stoer" && r.method != "dopri5" && r.method != "rosenbrock4")
+        fail("run.method", "must be \"bulirsch_stoer\", \"dopri5\" or \"rosenbrock4\", got \"" + r.method + "\"");
     }
   }
 
@@ -447,17 +449,17 @@ class Interpreter {
       for (size_t i = 0; i < a->size(); ++i) out.push_back(to_number(*a->get(i), path + "[" + std::to_string(i) + "]"));
       return out;
     }
-    fail(path, std::string("unsupported value (") + type_name(n.type()) +
+    fail(path, "unsupported value (" + toml_value_text(n) +
                    "; expected a boolean, number, string or array of numbers)");
   }
 
   void read_engines(const toml::node& node, Scene& s) const {
     const auto* t = node.as_table();
-    if (!t) fail("engines", std::string("expected a table of [engines.NAME] tables, got ") + type_name(node.type()));
+    if (!t) fail("engines", "expected a table of [engines.NAME] tables, got " + toml_value_text(node));
     for (auto&& [name, table] : *t) {
       const std::string prefix = "engines." + std::string(name.str());
       const auto* et = table.as_table();
-      if (!et) fail(prefix, std::string("expected a table, got ") + type_name(table.type()));
+      if (!et) fail(prefix, "expected a table, got " + toml_value_text(table));
       auto& dst = s.engines[std::string(name.str())];
       for (auto&& [k, v] : *et) dst[std::string(k.str())] = to_setting(v, prefix + "." + std::string(k.str()));
     }

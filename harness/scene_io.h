@@ -14,7 +14,9 @@ namespace tippe {
 // Invalid scene input. The message is always "FILE: KEY: reason" with KEY dotted
 // ("body.stem_radius", "engines.mujoco.timestep", "--set" for a malformed override), except
 // for TOML syntax errors, which read "FILE:LINE:COL: reason", and an unreadable file
-// ("FILE: cannot read: reason").
+// ("FILE: cannot read: reason"). A value outside its range reads
+// "FILE: KEY: VALUE is out of range (expected RANGE)"; a wrong type names the value too
+// ("expected a number, got a string '0.1'", as TOML writes it).
 class SceneError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
@@ -33,8 +35,8 @@ class SceneError : public std::runtime_error {
 //    given they must be positive and, for every scene, pass geometry_problems(body, stem).
 //  - optional with defaults: name (file stem; letters, digits, '.', '_', '-'), description
 //    (one line), contact.drilling (0), contact.stem (true), contact.flight (false),
-//    initial.velocity (not given), initial.omega_along_contact (false), run.rtol (1e-10,
-//    in (0, 1e-2]), run.atol (1e-12, in (0, 1]).
+//    initial.velocity (not given), initial.omega_along_contact (false), initial.height (0, >= 0),
+//    run.rtol (1e-10, in [1e-15, 1e-2]), run.atol (1e-12, in (0, 1]).
 //  - mass: either density (> 0) and mass_model ("solid" | "seed"), both required, then
 //    compute_mass_properties(body); or all four of mass, com_offset, inertia_transverse,
 //    inertia_axial (MassModel::Given; density and mass_model must then be absent), with
