@@ -28,9 +28,11 @@
 #include <stdexcept>
 #include <thread>
 
+#include "classify.h"
 #include "provenance.h"
 #include "records.h"
 #include "scene_io.h"
+#include "toml_text.h"
 #include "timing.h"
 
 namespace tippe {
@@ -40,33 +42,9 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+// A judgement: repeats only sharpen the minimum CPU time of a point, which settles after a few;
+// more than 100 is likelier a typo than a wish for a sweep that many times as long.
 constexpr int kMaxRepeats = 100;
-
-const char* type_name(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::none:
-      return "nothing";
-    case toml::node_type::table:
-      return "a table";
-    case toml::node_type::array:
-      return "an array";
-    case toml::node_type::string:
-      return "a string";
-    case toml::node_type::integer:
-      return "an integer";
-    case toml::node_type::floating_point:
-      return "a float";
-    case toml::node_type::boolean:
-      return "a boolean";
-    case toml::node_type::date:
-      return "a date";
-    case toml::node_type::time:
-      return "a time";
-    case toml::node_type::date_time:
-      return "a date-time";
-  }
-  return "?";
-}
 
 std::string num(double v) {
   std::ostringstream os;
@@ -111,6 +89,11 @@ class SweepReader {
     throw SceneError(file_ + ": " + key + ": " + why);
   }
 
+  // The one form of every range error, as in scene files: "KEY: VALUE is out of range (expected RANGE)".
+  [[noreturn]] void out_of_range(const std::string& key, const std::string& value, const std::string& expected) const {
+    fail(key, value + " is out of range (expected " + expected + ")");
+  }
+
   void keys(const toml::table& t, const std::string& prefix, std::initializer_list<const char*> allowed) const {
     for (auto&& [k, v] : t) {
       (void)v;
@@ -130,26 +113,26 @@ class SweepReader {
     else if (const auto* i = n.as_integer())
       v = static_cast<double>(i->get());
     else
-      fail(key, std::string("expected a number, got ") + type_name(n));
+      fail(key, "expected a number, got " + toml_value_text(n));
     if (!std::isfinite(v)) fail(key, "must be a finite number, got " + num(v));
     return v;
   }
 
   std::string string(const toml::node& n, const std::string& key) const {
     const auto* s = n.as_string();
-    if (!s) fail(key, std::string("expected a string, got ") + type_name(n));
+    if (!s) fail(key, "expected a string, got " + toml_value_text(n));
     return s->get();
   }
 
   const toml::array& array(const toml::node& n, const std::string& key) const {
     const auto* a = n.as_array();
-    if (!a) fail(key, std::string("expected an array, got ") + type_name(n));
+    if (!a) fail(key, "expected an array, got " + toml_value_text(n));
     return *a;
   }
 
   const toml::table& table(const toml::node& n, const std::string& key) const {
     const auto* t = n.as_table();
-    if (!t) fail(key, std::string("expected a table, got ") + type_name(n));
+    if (!t) fail(key, "expected a table, got " + toml_value_text(n));
     return *t;
   }
 
@@ -173,14 +156,14 @@ class SweepReader {
     }
     if (const toml::node* r = root.get("repeats")) {
       const auto* i = r->as_integer();
-      if (!i) fail("repeats", std::string("expected an integer, got ") + type_name(*r));
-      if (i->get() < 1 || i->get() > kMaxRepeats)
-        fail("repeats", "must lie in [1, " + std::to_string(kMaxRepeats) + "], got " + std::to_string(i->get()));
+      const std::string range = "1 <= repeats <= " + std::to_string(kMaxRepeats);
+      if (!i) fail("repeats", "expected an integer (" + range + "), got " + toml_value_text(*r));
+      if (i->get() < 1 || i->get() > kMaxRepeats) out_of_range("repeats", std::to_string(i->get()), range);
       s.repeats = static_cast<int>(i->get());
     }
     if (const toml::node* d = root.get("duration")) {
       s.duration = number(*d, "duration");
-      if (!(*s.duration > 0)) fail("duration", "must be > 0, got " + num(*s.duration));
+      if (!(*s.duration > 0)) out_of_range("duration", num(*s.duration), "duration > 0");
     }
 
     const toml::node* sc = root.get("scenes");
@@ -201,10 +184,10 @@ class SweepReader {
         e.file = string(*f, key + ".file");
         if (const toml::node* d = t->get("duration")) {
           e.duration = number(*d, key + ".duration");
-          if (!(*e.duration > 0)) fail(key + ".duration", "must be > 0, got " + num(*e.duration));
+          if (!(*e.duration > 0)) out_of_range(key + ".duration", num(*e.duration), "duration > 0");
         }
       } else {
-        fail(key, std::string("expected a file name or a table {file, duration}, got ") + type_name(n));
+        fail(key, "expected a file name or a table {file, duration}, got " + toml_value_text(n));
       }
       if (e.file.empty()) fail(key, "empty file name");
       e.path = (fs::path(e.file).is_absolute() ? fs::path(e.file) : base / e.file).lexically_normal().string();
@@ -213,6 +196,7 @@ class SweepReader {
 
     const toml::node* su = root.get("setup");
     if (!su) fail("setup", "missing (required: one or more [[setup]] tables)");
+    if (su->is_table()) fail("setup", "expected [[setup]] tables, got a table (write [[setup]], not [setup])");
     const toml::array& setups = array(*su, "setup");
     if (setups.empty()) fail("setup", "must have at least one [[setup]]");
     const std::vector<std::string> engines = available_engines();
@@ -441,6 +425,28 @@ std::optional<double> get_optional(const json& j, const char* key) {
   return v.get<double>();
 }
 
+json reference_json(const std::optional<SweepRecord::ReferenceRun>& f) {
+  if (!f) return nullptr;
+  return json{{"status", f->status},
+              {"method", f->method},
+              {"class", f->run_class},
+              {"rtol", number(f->rtol)},
+              {"cpu_seconds", number(f->cpu_seconds)},
+              {"steps", f->steps},
+              {"rhs_evaluations", f->rhs_evaluations},
+              {"energy_initial", number(f->energy_initial)},
+              {"energy_final", number(f->energy_final)},
+              {"jellett_max_relative_drift", number(f->jellett_max_relative_drift)},
+              {"final_tilt", number(f->final_tilt)}};
+}
+
+// The class a status implies when no trajectory is at hand (records from before classification).
+std::string class_of_status(const std::string& status) {
+  for (const char* c : {"ok", "diverged", "clamped", "failed", "contact_lost"})
+    if (status == c) return status;
+  return "failed";
+}
+
 }  // namespace
 
 json to_json(const SweepRecord& r) {
@@ -480,6 +486,8 @@ json to_json(const SweepRecord& r) {
       {"engine_version", r.engine_version},
       {"git_commit", r.git_commit},
       {"settings", r.settings},
+      {"class", {{"name", r.run_class}, {"time", number(r.class_time)}, {"reason", r.class_reason}}},
+      {"reference", reference_json(r.reference)},
   };
 }
 
@@ -521,6 +529,30 @@ SweepRecord sweep_record_from_json(const json& j) {
   r.git_commit = j.at("git_commit").get<std::string>();
   r.settings = j.at("settings");
   if (!r.settings.is_object()) throw std::invalid_argument("settings: expected an object");
+  if (j.contains("class")) {
+    const json& c = j.at("class");
+    r.run_class = c.at("name").get<std::string>();
+    r.class_time = get_number(c, "time");
+    r.class_reason = c.at("reason").get<std::string>();
+  } else {
+    r.run_class = class_of_status(r.status);
+  }
+  if (j.contains("reference") && !j.at("reference").is_null()) {
+    const json& x = j.at("reference");
+    SweepRecord::ReferenceRun f;
+    f.status = x.at("status").get<std::string>();
+    f.method = x.at("method").get<std::string>();
+    f.run_class = x.at("class").get<std::string>();
+    f.rtol = get_number(x, "rtol");
+    f.cpu_seconds = get_number(x, "cpu_seconds");
+    f.steps = json_integer(x, "steps");
+    f.rhs_evaluations = json_integer(x, "rhs_evaluations");
+    f.energy_initial = get_number(x, "energy_initial");
+    f.energy_final = get_number(x, "energy_final");
+    f.jellett_max_relative_drift = get_number(x, "jellett_max_relative_drift");
+    f.final_tilt = get_number(x, "final_tilt");
+    r.reference = f;
+  }
   return r;
 }
 
@@ -584,7 +616,24 @@ struct Reference {
   RunRecord record;
   Trajectory trajectory;
   bool cached = false;
+  std::optional<SweepRecord::ReferenceRun> summary;  // filled once loaded or computed
 };
+
+SweepRecord::ReferenceRun reference_summary(const Scene& scene, const Reference& ref) {
+  SweepRecord::ReferenceRun f;
+  f.status = ref.record.status;
+  f.method = scene.run.method;
+  f.rtol = scene.run.rtol;
+  f.cpu_seconds = ref.record.work.cpu_seconds;
+  f.steps = ref.record.work.steps;
+  f.rhs_evaluations = ref.record.work.rhs_evaluations;
+  f.energy_initial = ref.record.energy_initial;
+  f.energy_final = ref.record.energy_final;
+  f.jellett_max_relative_drift = ref.record.jellett_max_relative_drift;
+  f.final_tilt = ref.record.final_tilt;
+  f.run_class = to_string(classify_run(scene, ref.record, nullptr, ref.trajectory).kind);
+  return f;
+}
 
 std::string analytic_version(const Scene& scene) { return make_simulator("analytic", scene)->version(); }
 
@@ -716,6 +765,11 @@ SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Referenc
   r.solver_iterations = first.work.solver_iterations;
   r.engine_version = first.engine_version.empty() ? "unknown" : first.engine_version;
   r.settings = settings_object(first.settings);
+  const RunClass c = classify_run(p.scene, first, &r.metrics, sink.trajectory);
+  r.run_class = to_string(c.kind);
+  r.class_time = c.time;
+  r.class_reason = c.reason;
+  r.reference = ref.summary;
   return r;
 }
 
@@ -1071,6 +1125,7 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o) {
     const size_t i = to_compute[k];
     compute_reference(out / "reference" / plan.physics_hashes[i], plan.scenes[i], refs[i]);
   });
+  for (size_t i : needed) refs[i].summary = reference_summary(plan.scenes[i], refs[i]);
 
   if (!todo.empty()) {
     RecordAppender appender(records_file);

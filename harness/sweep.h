@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
@@ -107,6 +108,21 @@ struct SweepRecord {
   long long steps = 0, rhs_evaluations = 0, solver_iterations = 0;
   std::string engine_version, git_commit;
   nlohmann::json settings = nlohmann::json::object();  // every accuracy setting in force
+  // classify_run of this run (classify.h): ok, diverged, unphysical, clamped, failed or
+  // contact_lost, when it happened (NaN: not dated, or ok) and why. Records written before
+  // classification existed read back with the class their status implies.
+  std::string run_class = "ok";
+  double class_time = std::numeric_limits<double>::quiet_NaN();
+  std::string class_reason;
+  // The reference's own run on this scene (the same for every point of it), so that the report
+  // shows how the reference itself fares at the extremes: cost, conservation, its class.
+  struct ReferenceRun {
+    std::string status, method, run_class;
+    double rtol = 0, cpu_seconds = 0;
+    long long steps = 0, rhs_evaluations = 0;
+    double energy_initial = 0, energy_final = 0, jellett_max_relative_drift = 0, final_tilt = 0;
+  };
+  std::optional<ReferenceRun> reference;  // absent in records written before it existed
 };
 nlohmann::json to_json(const SweepRecord& r);
 // Throws nlohmann::json::exception for a missing or mistyped field, std::invalid_argument for

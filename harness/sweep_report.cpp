@@ -179,6 +179,8 @@ std::string short_setting(const SweepRecord& r) {
 struct Table {
   std::vector<std::string> header;
   std::vector<std::vector<std::string>> rows;
+  // Optional CSS class of each cell (same shape as rows; "" for none): the HTML colours.
+  std::vector<std::vector<std::string>> css = {};
 };
 struct Block {
   enum Kind { H1, H2, H3, Para, Tab, Image } kind;
@@ -243,6 +245,12 @@ std::string render_page(const std::vector<Block>& doc, const std::string& title)
         "figure { margin: 1em 0; } figure img { max-width: 100%; border: 1px solid #ddd; }\n"
         "figcaption { font-size: 0.9em; color: #444; }\n"
         "h2 { border-bottom: 2px solid #ddd; margin-top: 2em; }\n"
+        // Stability map: one colour per run class; `regime` marks a run that finished but parts
+        // from the reference's regime (inverts where it does not, or the reverse).
+        "td.c-ok { background: #c8e6c9; } td.c-regime { background: #fff59d; }\n"
+        "td.c-unphysical { background: #ffcc80; } td.c-clamped { background: #ce93d8; }\n"
+        "td.c-diverged { background: #ef9a9a; } td.c-failed { background: #bdbdbd; }\n"
+        "td.c-contact_lost { background: #90caf9; }\n"
         "</style>\n</head>\n<body>\n";
   for (const Block& b : doc) {
     switch (b.kind) {
@@ -266,9 +274,14 @@ std::string render_page(const std::vector<Block>& doc, const std::string& title)
         os << "<table>\n<thead><tr>";
         for (const auto& h : b.table.header) os << "<th>" << html_escape(h) << "</th>";
         os << "</tr></thead>\n<tbody>\n";
-        for (const auto& row : b.table.rows) {
+        for (size_t i = 0; i < b.table.rows.size(); ++i) {
           os << "<tr>";
-          for (const auto& c : row) os << "<td>" << html_escape(c) << "</td>";
+          for (size_t j = 0; j < b.table.rows[i].size(); ++j) {
+            const std::string cls =
+                i < b.table.css.size() && j < b.table.css[i].size() ? b.table.css[i][j] : std::string();
+            os << (cls.empty() ? "<td>" : "<td class=\"" + html_escape(cls) + "\">") << html_escape(b.table.rows[i][j])
+               << "</td>";
+          }
           os << "</tr>\n";
         }
         os << "</tbody>\n</table>\n";
@@ -660,6 +673,100 @@ void scene_section(const SceneGroup& s, const std::vector<std::string>& images, 
   doc.push_back({Block::Tab, "", all_t, {}});
 }
 
+std::string class_cell(const SweepRecord& r) {
+  std::string text = r.run_class;
+  if (std::isfinite(r.class_time)) text += " at " + fmt("%.4g", r.class_time);
+  if (r.run_class == "ok" && !agrees_with_reference_regime(r)) text += ", regime differs";
+  return text;
+}
+std::string class_css(const SweepRecord& r) {
+  if (r.run_class == "ok") return agrees_with_reference_regime(r) ? "c-ok" : "c-regime";
+  return "c-" + r.run_class;
+}
+
+// The stability map (setup x scene x ladder value, each cell the run's class) and the reference's
+// own run on every scene, reported the same way.
+void stability_section(const std::vector<SceneGroup>& scenes, std::vector<Block>& doc) {
+  doc.push_back({Block::H2, "Stability map", {}, {}});
+  doc.push_back(
+      {Block::Para,
+       "Every run classified (harness/classify.h): ok; diverged (NaN, energy above 2 E0, G below the floor by more "
+       "than R/10, speed blow-up); unphysical (energy gain in a dissipative scene, or Jellett's integral drifting "
+       "beyond 1e-3 where it must hold); clamped (an engine limit hit, e.g. Bullet's angular-velocity clamp); failed "
+       "(the engine refused the scene or threw); contact_lost; with the time it happened. \"regime differs\": the run "
+       "finished but inverts where the reference does not, or the reverse. One table per setup: scenes down, its "
+       "ladder across.",
+       {},
+       {}});
+  std::vector<std::string> order;
+  for (const SceneGroup& s : scenes)
+    for (const SetupGroup& u : s.setups)
+      if (std::find(order.begin(), order.end(), u.name) == order.end()) order.push_back(u.name);
+  for (const std::string& name : order) {
+    std::map<long long, double> ladder;  // ladder index -> value
+    std::string key, engine;
+    for (const SceneGroup& s : scenes)
+      for (const SetupGroup& u : s.setups)
+        if (u.name == name) {
+          key = u.key;
+          engine = u.engine;
+          for (const SweepRecord& r : u.points) ladder[r.ladder_index] = r.ladder_value;
+        }
+    Table t{{"scene \\ " + key}, {}, {}};
+    for (const auto& [i, v] : ladder) t.header.push_back(fmt("%g", v));
+    for (const SceneGroup& s : scenes) {
+      std::vector<std::string> row{s.name}, css{""};
+      for (const auto& [i, v] : ladder) {
+        std::string cell = "-", c;
+        for (const SetupGroup& u : s.setups)
+          if (u.name == name)
+            for (const SweepRecord& r : u.points)
+              if (r.ladder_index == i) {
+                cell = class_cell(r);
+                c = class_css(r);
+              }
+        row.push_back(cell);
+        css.push_back(c);
+      }
+      t.rows.push_back(row);
+      t.css.push_back(css);
+    }
+    doc.push_back({Block::H3, name + " (" + engine + ")", {}, {}});
+    doc.push_back({Block::Tab, "", t, {}});
+  }
+
+  doc.push_back({Block::H3, "The reference on each scene", {}, {}});
+  doc.push_back({Block::Para,
+                 "The analytic reference at the scene's own tolerance, against which every point is measured: its "
+                 "cost, its own class, its energy balance |E_end - E0| / E0 (a conservation error only where the "
+                 "friction law conserves energy: none or rolling) and the largest relative drift of Jellett's "
+                 "integral on one surface.",
+                 {},
+                 {}});
+  Table rt{{"scene", "method", "rtol", "status", "class", "steps", "rhs evals", "CPU s", "|E_end - E0| / E0",
+            "Jellett drift", "inversion t"},
+           {},
+           {}};
+  for (const SceneGroup& s : scenes) {
+    std::optional<SweepRecord::ReferenceRun> f;
+    for (const SetupGroup& u : s.setups)
+      for (const SweepRecord& r : u.points)
+        if (r.reference) f = r.reference;
+    if (!f) {
+      rt.rows.push_back({s.name, "-", "-", "-", "-", "-", "-", "-", "-", "-", time_text(s.reference_inversion)});
+      rt.css.push_back({});
+      continue;
+    }
+    const double de = f->energy_initial != 0 ? std::fabs(f->energy_final - f->energy_initial) / std::fabs(f->energy_initial)
+                                             : std::numeric_limits<double>::quiet_NaN();
+    rt.rows.push_back({s.name, f->method, fmt("%g", f->rtol), f->status, f->run_class, std::to_string(f->steps),
+                       std::to_string(f->rhs_evaluations), g3(f->cpu_seconds), g3(de), g3(f->jellett_max_relative_drift),
+                       time_text(s.reference_inversion)});
+    rt.css.push_back({"", "", "", "", f->run_class == "ok" ? "c-ok" : "c-" + f->run_class});
+  }
+  doc.push_back({Block::Tab, "", rt, {}});
+}
+
 std::vector<Block> build_doc(const std::vector<SweepRecord>& records, const std::vector<std::string>& images,
                              const std::string& plots_note) {
   std::vector<Block> doc;
@@ -715,6 +822,7 @@ std::vector<Block> build_doc(const std::vector<SweepRecord>& records, const std:
                  "tables.",
                  {},
                  {}});
+  stability_section(scenes, doc);
   for (const SceneGroup& s : scenes) scene_section(s, images, doc);
   return doc;
 }

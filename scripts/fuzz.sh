@@ -1,19 +1,20 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets with clang in build-fuzz and runs each for SECONDS: scripts/fuzz.sh SECONDS [TARGET...]
+# Builds the libFuzzer targets with clang in build-asan (shared with scripts/sanitize.sh) and runs them side by side, each for SECONDS: scripts/fuzz.sh SECONDS [TARGET...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$(pwd)"
 seconds="${1:-60}"
 shift || true
-build="${FUZZ_BUILD_DIR:-$root/build-fuzz}"
+build="${FUZZ_BUILD_DIR:-$root/build-asan}"
 cxx="${FUZZ_CXX:-clang++}"
 command -v "$cxx" >/dev/null || { echo "fuzz: $cxx not found (install clang and libclang-rt-14-dev)" >&2; exit 2; }
 
 # -O1 with line tables: fast to build and to fuzz, with file:line in the reports. ASan/UBSan make
 # a memory error or undefined behaviour a crash the fuzzer stops on, not a silent corruption.
+# The same configuration as scripts/sanitize.sh, so that after it only the targets are built.
 cmake -S . -B "$build" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DTIPPE_FUZZ=ON -DTIPPE_SANITIZE=address,undefined \
-  -DTIPPE_BENCHMARKS=OFF >/dev/null
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DTIPPE_SANITIZE=address,undefined \
+  -DTIPPE_FUZZ=ON -DTIPPE_BENCHMARKS=OFF >/dev/null
 list="$build/fuzz/fuzz_targets.txt"
 mapfile -t lines < <(grep -v '^[[:space:]]*$' "$list")
 targets=()
@@ -25,7 +26,9 @@ echo "fuzz: built ${targets[*]} in $(( $(date +%s) - t0 )) s"
 
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:symbolize=1}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
-status=0
+# One fuzzer per target, all at once (one core each on the CI machine's two): the wall time is
+# SECONDS, not SECONDS per target.
+pids=()
 for name in "${targets[@]}"; do
   line="$(grep "^$name " "$list" || true)"
   [ -n "$line" ] || { echo "fuzz: unknown target $name (see $list)" >&2; exit 2; }
@@ -41,8 +44,15 @@ for name in "${targets[@]}"; do
         -print_final_stats=1 -artifact_prefix="$artifacts/$name-")
   [ "$dict" != "-" ] && args+=(-dict="$dict")
   echo "fuzz: $name for $seconds s (log: $log)"
+  "$build/fuzz/$name" "${args[@]}" >"$log" 2>&1 &
+  pids+=($!)
+done
+status=0
+for i in "${!targets[@]}"; do
+  name="${targets[$i]}"
+  log="$build/$name.log"
   rc=0
-  "$build/fuzz/$name" "${args[@]}" >"$log" 2>&1 || rc=$?
+  wait "${pids[$i]}" || rc=$?
   execs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)"
   rate="$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -n 1)"
   cov="$(grep -o 'cov: [0-9]*' "$log" | tail -n 1 || true)"
@@ -50,7 +60,7 @@ for name in "${targets[@]}"; do
   if [ "$rc" -ne 0 ]; then
     echo "fuzz: $name FAILED; the end of its log:" >&2
     tail -n 60 "$log" >&2
-    ls -1 "$artifacts" | sed "s|^|fuzz: artifact $artifacts/|" >&2
+    ls -1 "$build/artifacts" | sed "s|^|fuzz: artifact $build/artifacts/|" >&2
     status=1
   fi
 done

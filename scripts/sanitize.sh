@@ -10,10 +10,12 @@ command -v "$cxx" >/dev/null || { echo "sanitize: $cxx not found" >&2; exit 2; }
 # clang: its -fsanitize=undefined also checks float->int conversions that overflow, which g++'s
 # does not. -O1 with line tables only (all a stack trace needs) keeps the build and the run
 # affordable; asserts stay on (no NDEBUG) so Eigen's and the project's own checks run too.
+# TIPPE_FUZZ=ON adds libFuzzer's coverage instrumentation (the sanitizer runtime serves it), so
+# that scripts/fuzz.sh reuses this very build instead of compiling everything a second time.
 t0=$(date +%s)
 cmake -S . -B "$build" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DTIPPE_SANITIZE=address,undefined \
-  -DTIPPE_BENCHMARKS=OFF >/dev/null
+  -DTIPPE_FUZZ=ON -DTIPPE_BENCHMARKS=OFF >/dev/null
 cmake --build "$build" -j"${JOBS:-$(nproc)}"
 t1=$(date +%s)
 echo "sanitize: build $(( t1 - t0 )) s"
