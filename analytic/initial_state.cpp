@@ -8,7 +8,10 @@ BodyState scene_initial_state(const Scene& scene) {
   BodyState x;
   x.t = 0.0;
   x.q_WB = Quat(Eigen::AngleAxisd(scene.initial.tilt, Vec3::UnitX()));
-  const Vec3 R_C_W = contact_offset_W(m, x.q_WB, Surface::Ball);
+  // The body rests on whichever surface is lower at this tilt: the ball, or beyond the
+  // switching tilt the stem tip (a top that starts already inverted).
+  const Surface low = lower_surface(m, x.q_WB);
+  const Vec3 R_C_W = contact_offset_W(m, x.q_WB, low);
   const Vec3 R_C_B = x.q_WB.conjugate() * R_C_W;
   if (scene.initial.omega_along_contact) {
     // R_C points down the axis (R_C . e_Z = d - R cos(tilt) < 0 for a top with d < R), so
@@ -26,14 +29,15 @@ BodyState scene_initial_state(const Scene& scene) {
   } else {
     x.v_WG = Vec3(scene.initial.velocity[0], scene.initial.velocity[1], 0.0);
   }
-  // v_Oz = 0: the ball centre moves horizontally while the ball touches the floor. A start
-  // above the floor (free flight) keeps v_Gz = 0 instead.
+  // The centre of the touching sphere (O for the ball, P for the stem tip) moves horizontally
+  // while it touches the floor. A start above the floor (free flight) keeps v_Gz = 0 instead.
   const Vec3 e_Z = x.q_WB * Vec3::UnitZ();
   if (scene.initial.height > 0) {
     x.p_WG.z() += scene.initial.height;
     x.v_WG.z() = 0.0;
   } else {
-    x.v_WG.z() = -(w_W.cross(m.d * e_Z)).z();
+    const double z_centre = low == Surface::Stem ? m.z_P() : m.z_O();
+    x.v_WG.z() = -(w_W.cross(z_centre * e_Z)).z();
   }
   return x;
 }

@@ -3,8 +3,10 @@
 // changes (impacts, stick/slip, release) applied at the event.
 #include "reference_model.h"
 
+#include "boost_binomial.h"  // first: it must precede every Boost.Math and Odeint header
 #include <boost/math/tools/toms748_solve.hpp>
 #include <boost/numeric/odeint.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -696,7 +698,9 @@ ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene
     impl_->restart(0.0, y0);
     return;
   }
-  impl_->mode = impl_->settle(y0, {true, false}, none);
+  // On the surface the initial state rests on: the ball, or the stem of a top started inverted.
+  const bool on_stem = lower_surface(body_, x0.q_WB) == Surface::Stem;
+  impl_->mode = impl_->settle(y0, {!on_stem, on_stem}, none);
   if (!impl_->mode.any_active()) {
     impl_->end(ReferenceStatus::ContactLost, 0.0, "F_n < 0 at the start: the floor cannot hold the top", y0);
     return;

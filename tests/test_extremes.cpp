@@ -10,6 +10,9 @@
 #include <set>
 #include <sstream>
 
+#include "initial_state.h"
+#include "observables.h"
+#include "reference_model.h"
 #include "scene_io.h"
 #include "sweep.h"
 
@@ -182,4 +185,26 @@ TEST(ExtremesBattery, ShortVariantClassifiesEveryPoint) {
   const std::string md = slurp(out / "report.md");
   EXPECT_NE(md.find("## Stability map"), std::string::npos);
   EXPECT_NE(md.find("### The reference on each scene"), std::string::npos);
+}
+
+// A top started beyond the switching tilt (already inverted) rests on its stem tip, not on a
+// ball whose stem would be deep in the floor; the reference starts in stem contact carrying the
+// weight. Tolerances: the gap is a sum of terms of size R (1e-12 R is round-off); the stem's
+// normal force balances M g up to the centripetal and tilt terms of a spinning start (10 %).
+TEST(ExtremesStart, InvertedStartRestsOnTheStem) {
+  const Scene scene = load_scene(kSource + "/harness/scenes/extremes/tilt_near_pi.toml");
+  const BodyModel m = BodyModel::from_scene(scene);
+  const BodyState x0 = scene_initial_state(scene);
+  ASSERT_EQ(lower_surface(m, x0.q_WB), Surface::Stem);
+  EXPECT_NEAR(surface_gap(m, x0, Surface::Stem), 0.0, 1e-12 * m.R);
+  EXPECT_GT(surface_gap(m, x0, Surface::Ball), 0.01 * m.R);
+  // The tip's centre P moves horizontally at the start.
+  const Vec3 w_W = x0.q_WB * x0.w_B;
+  const Vec3 v_P = x0.v_WG + w_W.cross(m.z_P() * (x0.q_WB * Vec3::UnitZ()));
+  EXPECT_NEAR(v_P.z(), 0.0, 1e-12 * (1.0 + w_W.norm() * m.R));
+  ReferenceModel ref(scene);
+  ASSERT_EQ(ref.status(), ReferenceStatus::Ok) << ref.status_detail();
+  EXPECT_EQ(ref.contact_surface(), Surface::Stem);
+  EXPECT_NEAR(ref.forces().normal[1], m.M * m.g, 0.1 * m.M * m.g);
+  EXPECT_EQ(ref.forces().normal[0], 0.0);
 }
