@@ -67,13 +67,13 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
   const Eigen::Matrix3d R_WB = q.toRotationMatrix();
   const Vec3 w_W = R_WB * x.w_B;
   const Vec3 I_B(m_.A, m_.A, m_.C);
-  const Eigen::Matrix3d I_W = R_WB * I_B.asDiagonal() * R_WB.transpose();
+  // I_W w_W = R (I_B w_B): the world inertia itself is not needed, only its inverse.
   const Eigen::Matrix3d Iinv_W = R_WB * I_B.cwiseInverse().asDiagonal() * R_WB.transpose();
   const Vec3 e_z = Vec3::UnitZ();
 
   ContactForces out;
   Vec3 F_known = -m_.M * m_.g * e_z;
-  Vec3 T_known = -w_W.cross(I_W * w_W);
+  Vec3 T_known = -w_W.cross(R_WB * I_B.cwiseProduct(x.w_B));
   Column cols[kMaxUnknowns];
   Row rows[kMaxUnknowns];
   int n = 0;
@@ -86,7 +86,11 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
   for (int s = 0; s < 2; ++s) {
     const ContactSlot& slot = mode.slot[s];
     if (!slot.active) continue;
-    const ContactGeometry g = geometry(x, s);
+    // geometry(x, s) from the rotation already at hand (it would normalize q again).
+    ContactGeometry g;
+    g.radius = s == 0 ? m_.R : m_.r;
+    g.r_GO_W = (s == 0 ? m_.z_O() : m_.z_P()) * Vec3(R_WB.col(2));
+    g.r_GC_W = g.r_GO_W - g.radius * Vec3::UnitZ();
     const Vec3& r = g.r_GC_W;
     Vec3 slip = x.v_WG + w_W.cross(r);
     slip.z() = 0.0;
@@ -153,15 +157,29 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
     VecN b(n);
     const Vec3 a_free = F_known / m_.M;
     const Vec3 alpha_free = Iinv_W * T_known;
+    // Angular acceleration per unit of each unknown, once per column rather than once per entry.
+    Vec3 alpha_col[kMaxUnknowns];
+    for (int j = 0; j < n; ++j) alpha_col[j] = Iinv_W * cols[j].tau;
     for (int i = 0; i < n; ++i) {
       b(i) = -(rows[i].f.dot(a_free) + rows[i].tau.dot(alpha_free) + rows[i].bias);
-      for (int j = 0; j < n; ++j)
-        K(i, j) = rows[i].f.dot(cols[j].f) / m_.M + rows[i].tau.dot(Iinv_W * cols[j].tau);
+      for (int j = 0; j < n; ++j) K(i, j) = rows[i].f.dot(cols[j].f) / m_.M + rows[i].tau.dot(alpha_col[j]);
     }
     if (n == 1) {
       // One sliding or frictionless contact: the common case of a run, solved directly.
       out.solvable = K(0, 0) != 0.0;
       u(0) = b(0) / K(0, 0);
+    } else if (n == 3) {
+      // Three unknowns, mostly one sticking contact (rolling, Coulomb stick): the common case of
+      // a rolling run. The closed-form inverse costs a fifth of the pivoting LU of the general
+      // case (BENCHMARKS.md). Singular relative to the entries' scale, not to Eigen's absolute
+      // 1e-12 on the determinant, which would misjudge a heavy body in SI units.
+      const Eigen::Matrix3d K3 = K.topLeftCorner<3, 3>();
+      const double scale = K3.cwiseAbs().maxCoeff();
+      Eigen::Matrix3d inv = Eigen::Matrix3d::Zero();
+      bool invertible = false;
+      K3.computeInverseWithCheck(inv, invertible, 1e-13 * scale * scale * scale);
+      out.solvable = invertible;
+      u = inv * Eigen::Vector3d(b.head<3>());
     } else {
       const auto lu = K.fullPivLu();
       out.solvable = lu.isInvertible();
@@ -192,7 +210,7 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
 
   if (dydt) {
     const Vec3 a_G = F / m_.M;
-    const Vec3 wdot_B = R_WB.transpose() * (Iinv_W * T);
+    const Vec3 wdot_B = I_B.cwiseInverse().cwiseProduct(R_WB.transpose() * T);
     // Quaternion rate from body-frame omega, plus a term that pulls |q| back to 1 at the rate
     // of the motion: the unit sphere is invariant, so the exact solution is unchanged.
     const double kappa = std::max(1.0, x.w_B.norm());
