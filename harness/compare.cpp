@@ -565,10 +565,16 @@ void run_task(Task& task, const Scene& scene, ProgressBoard& board, size_t slot)
     board.stopped(slot, task.record.status);
 }
 
+void copy_file_atomic(const fs::path& from, const fs::path& to) {
+  const fs::path tmp = to.string() + ".tmp." + std::to_string(::getpid());
+  fs::copy_file(from, tmp, fs::copy_options::overwrite_existing);
+  fs::rename(tmp, to);
+}
+
 std::string analytic_version(const Scene& scene) { return make_simulator("analytic", scene)->version(); }
 
-// The cached reference when it is complete and was made from the same physics by the same
-// build of the reference (same commit, same version string); anything else is re-run.
+}  // namespace
+
 bool load_cached_reference(const fs::path& dir, const Scene& scene, const std::string& hash, RunRecord& record,
                            Trajectory& trajectory) {
   const fs::path summary = dir / "summary.json", csv = dir / "trajectory.csv";
@@ -588,14 +594,6 @@ bool load_cached_reference(const fs::path& dir, const Scene& scene, const std::s
     return false;
   }
 }
-
-void copy_file_atomic(const fs::path& from, const fs::path& to) {
-  const fs::path tmp = to.string() + ".tmp." + std::to_string(::getpid());
-  fs::copy_file(from, tmp, fs::copy_options::overwrite_existing);
-  fs::rename(tmp, to);
-}
-
-}  // namespace
 
 Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
   // Every check on the input comes before the first file is written.

@@ -1,6 +1,8 @@
 // Side-by-side runs of the reference and engines on one scene, and the metrics that compare them.
 #pragma once
 
+#include <filesystem>
+
 #include <functional>
 #include <optional>
 #include <string>
@@ -121,5 +123,11 @@ Comparison comparison_from_json(const nlohmann::json& j);
 std::string physics_hash(const Scene& scene);
 // The same over a scene_to_json document (e.g. a record's scene_spec).
 std::string physics_hash(const nlohmann::json& scene_json);
+
+// A reference cache entry, DIR/{summary.json, trajectory.csv} (shared by compare, gate and
+// sweep): loaded when both files are complete and were made from the physics `hash` by this
+// build of the reference (same commit, same version string); false for anything else.
+bool load_cached_reference(const std::filesystem::path& dir, const Scene& scene, const std::string& hash,
+                           RunRecord& record, Trajectory& trajectory);
 
 }  // namespace tippe

@@ -635,27 +635,10 @@ SweepRecord::ReferenceRun reference_summary(const Scene& scene, const Reference&
   return f;
 }
 
-std::string analytic_version(const Scene& scene) { return make_simulator("analytic", scene)->version(); }
-
-// Same rule as the comparison cache: same physics, same build of the reference, complete files.
+// The comparison cache's rule (load_cached_reference): same physics, same build, complete files.
 bool load_reference(const fs::path& dir, const Scene& scene, const std::string& hash, Reference& ref) {
-  const fs::path summary = dir / "summary.json", csv = dir / "trajectory.csv";
-  std::error_code ec;
-  if (!fs::exists(summary, ec) || !fs::exists(csv, ec)) return false;
-  try {
-    std::ifstream in(summary);
-    const RunRecord r = from_json(json::parse(in));
-    if (r.engine != "analytic" || physics_hash(r.scene_spec) != hash) return false;
-    if (r.provenance.git_commit != build_info().git_commit || r.engine_version != analytic_version(scene)) return false;
-    Trajectory tr = Trajectory::from_csv(read_trajectory_csv(csv.string()));
-    if (static_cast<long long>(tr.size()) != r.samples) return false;
-    ref.record = r;
-    ref.trajectory = std::move(tr);
-    ref.cached = true;
-    return true;
-  } catch (const std::exception&) {
-    return false;
-  }
+  ref.cached = load_cached_reference(dir, scene, hash, ref.record, ref.trajectory);
+  return ref.cached;
 }
 
 // Runs the reference at the scene's own tolerances into the cache; the summary goes last, so its
