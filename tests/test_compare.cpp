@@ -17,29 +17,13 @@
 #include "records.h"
 #include "report.h"
 #include "scene_io.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
 
 namespace {
-
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "tippe-compare-XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 // Sets an environment variable for one scope.
 class EnvGuard {
@@ -62,13 +46,6 @@ class EnvGuard {
   std::string name_;
   std::optional<std::string> old_;
 };
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // A scene built in code: R = 2 so that path errors divided by R are told apart from raw ones.
 Scene test_scene() {
@@ -361,7 +338,7 @@ TEST(Metrics, PhysicsHashIgnoresNamesAndEngineSettings) {
 }
 
 TEST(Trajectories, SinkKeepsSamplesAndForwardsThem) {
-  TempDir dir;
+  TempDir dir{"tippe-compare"};
   const std::string path = (dir.path() / "t.csv").string();
   CsvTrajectoryWriter csv(path);
   TrajectorySink sink({&csv});
@@ -525,7 +502,7 @@ struct Fixture {
 TEST(Report, HtmlIsWellFormedWithPlotsAndFooter) {
   std::string why;
   if (gnuplot_command(&why).empty()) GTEST_SKIP() << why;
-  TempDir dir;
+  TempDir dir{"tippe-compare"};
   const Fixture f(dir.path());
   write_report(dir.path().string(), f.comparison, true);
   const std::string html = slurp(dir.path() / "index.html");
@@ -566,7 +543,7 @@ TEST(Report, HtmlIsWellFormedWithPlotsAndFooter) {
 }
 
 TEST(Report, EventErrorsAreGradedAndTolerancesColourMetrics) {
-  TempDir dir;
+  TempDir dir{"tippe-compare"};
   Fixture f(dir.path());
   // ode inverts 0.02 after the reference at 0.98: 2 % -> amber.
   std::string html = render_html(f.comparison, {});
@@ -580,7 +557,7 @@ TEST(Report, EventErrorsAreGradedAndTolerancesColourMetrics) {
 }
 
 TEST(Report, WithoutGnuplotThePageSaysPlotsSkipped) {
-  TempDir dir;
+  TempDir dir{"tippe-compare"};
   const Fixture f(dir.path());
   {
     EnvGuard env("TIPPE_GNUPLOT", "none");
@@ -615,7 +592,7 @@ TEST(Report, WithoutGnuplotThePageSaysPlotsSkipped) {
 }
 
 TEST(Report, ComparisonJsonRoundTrip) {
-  TempDir dir;
+  TempDir dir{"tippe-compare"};
   const Fixture f(dir.path());
   const Comparison c = comparison_from_json(f.comparison);
   EXPECT_EQ(to_json(c), f.comparison);
@@ -656,7 +633,7 @@ const std::string kScene = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/sour
 
 TEST(CompareCli, WritesEveryFileAndReusesTheReferenceCache) {
   ASSERT_TRUE(fs::exists(std::string(TIPPE_BINARY_DIR) + "/tippe")) << "build the tippe target first";
-  TempDir dir;
+  TempDir dir{"tippe-compare"};
   const fs::path out = dir.path() / "out", cache = dir.path() / "cache", err = dir.path() / "err.txt";
   const std::string args = "compare " + kScene + " --set run.duration=0.5 --engines ode --jobs 2 --out " +
                            out.string() + " --cache " + cache.string();
@@ -698,7 +675,7 @@ TEST(CompareCli, WritesEveryFileAndReusesTheReferenceCache) {
 }
 
 TEST(CompareCli, InvalidInputExitsWithTwoAndWritesNothing) {
-  TempDir dir;
+  TempDir dir{"tippe-compare"};
   const fs::path out = dir.path() / "out", cache = dir.path() / "cache", err = dir.path() / "err.txt";
   const std::string tail = " --out " + out.string() + " --cache " + cache.string();
   EXPECT_EQ(run_tippe("compare " + kScene + " --engines ode,nosuch" + tail, err), 2);
@@ -713,7 +690,7 @@ TEST(CompareCli, InvalidInputExitsWithTwoAndWritesNothing) {
 }
 
 TEST(RunComparison, UnknownEngineThrowsBeforeWriting) {
-  TempDir dir;
+  TempDir dir{"tippe-compare"};
   const Scene scene = load_scene(kScene, {"run.duration=0.1"});
   CompareOptions o;
   o.engines = {"ode", "nosuch"};

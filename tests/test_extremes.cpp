@@ -15,6 +15,7 @@
 #include "reference_model.h"
 #include "scene_io.h"
 #include "sweep.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
@@ -24,26 +25,6 @@ namespace {
 
 const std::string kSource = TIPPE_SOURCE_DIR;
 const std::string kBinary = std::string(TIPPE_BINARY_DIR) + "/tippe";
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string t = (fs::temp_directory_path() / "tippe-extremes-XXXXXX").string();
-    if (!::mkdtemp(t.data())) throw std::runtime_error("mkdtemp failed");
-    path = t;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
 
 SweepRecord point(const std::string& scene, long long scene_index, const std::string& setup, long long ladder_index,
                   double dt, const std::string& cls, double cls_time, bool inverts) {
@@ -122,9 +103,9 @@ TEST(ExtremesReport, StabilityMapHasOneCellPerPointColouredByClass) {
   EXPECT_NE(md.find("| spin_high | bulirsch_stoer | 1e-10 | ok | ok | 100 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| 0.25 | 1e-13 |"), std::string::npos) << md;
 
-  TempDir dir;
-  write_sweep_report(dir.path.string(), rs, false);
-  const std::string html = slurp(dir.path / "index.html");
+  TempDir dir{"tippe-extremes"};
+  write_sweep_report(dir.path().string(), rs, false);
+  const std::string html = slurp(dir.path() / "index.html");
   for (const char* cls : {"c-diverged", "c-unphysical", "c-regime", "c-clamped", "c-ok"})
     EXPECT_NE(html.find(std::string("<td class=\"") + cls + "\">"), std::string::npos) << cls;
 }
@@ -156,11 +137,11 @@ TEST(ExtremesFiles, BatteryScenesAndSweepsLoad) {
 // keeping Jellett's integral (which holds for the viscous and Coulomb laws on one surface) to
 // 1e-9 on every extreme, and the stability map in the report.
 TEST(ExtremesBattery, ShortVariantClassifiesEveryPoint) {
-  TempDir dir;
-  const fs::path out = dir.path / "out";
+  TempDir dir{"tippe-extremes"};
+  const fs::path out = dir.path() / "out";
   const std::string cmd = "cd '" + kSource + "' && '" + kBinary + "' sweep harness/sweeps/extremes-short.toml --out '" +
-                          out.string() + "' --jobs 2 > '" + (dir.path / "log").string() + "' 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(dir.path / "log");
+                          out.string() + "' --jobs 2 > '" + (dir.path() / "log").string() + "' 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(dir.path() / "log");
   const RecordsFile f = read_records((out / "records.jsonl").string());
   const SweepPlan plan = load_sweep(kSource + "/harness/sweeps/extremes-short.toml");
   ASSERT_EQ(f.records.size(), plan.points.size());

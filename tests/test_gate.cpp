@@ -18,6 +18,7 @@
 #include "gate.h"
 #include "records.h"
 #include "scene_io.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
@@ -28,35 +29,6 @@ namespace {
 const std::string kSource = TIPPE_SOURCE_DIR;
 const std::string kBinary = std::string(TIPPE_BINARY_DIR) + "/tippe";
 const std::string kScene = kSource + "/harness/scenes/source_dimensionless.toml";
-
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "tippe-gate-XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void spit(const fs::path& p, const std::string& text) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p) << text;
-}
 
 struct Exit {
   int code = -1;
@@ -512,7 +484,7 @@ namespace {
 
 // A gate directory beside a copy of the scene, so that relative scene paths are exercised.
 struct GateDir {
-  TempDir tmp;
+  TempDir tmp{"tippe-gate"};
   fs::path gate;
   GateDir() {
     fs::create_directories(tmp.path() / "scenes");
@@ -763,7 +735,7 @@ max.tilt_rms_error = 0.01
 }
 
 TEST(GateCommand, TightThresholdExits1AndNamesTheMetric) {
-  TempDir tmp;
+  TempDir tmp{"tippe-gate"};
   const fs::path junit = tmp.path() / "junit.xml", json_out = tmp.path() / "gate.json";
   const std::string gate = kSource + "/harness/gates/examples/failing.toml";
   const Exit e = run_tippe("gate " + gate + " --junit " + junit.string() + " --json " + json_out.string() +
@@ -784,7 +756,7 @@ TEST(GateCommand, TightThresholdExits1AndNamesTheMetric) {
 }
 
 TEST(GateCommand, ShippedDefaultGatesPass) {
-  TempDir tmp;
+  TempDir tmp{"tippe-gate"};
   const Exit e = run_tippe("gate " + kSource + "/harness/gates/default.toml --jobs 2 --cache " +
                                (tmp.path() / "cache").string(),
                            tmp.path());

@@ -16,6 +16,7 @@
 #include "records.h"
 #include "scene_io.h"
 #include "sweep.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
@@ -171,29 +172,6 @@ std::vector<Case> cases() {
 
 void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
-class TempDir {
- public:
-  TempDir() {
-    std::string templ = (fs::temp_directory_path() / "tippe_input_XXXXXX").string();
-    if (!::mkdtemp(templ.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = templ;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = path_ / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-
- private:
-  fs::path path_;
-};
-
 std::string error_of(const std::function<void()>& f) {
   try {
     f();
@@ -207,7 +185,7 @@ class InputTable : public ::testing::TestWithParam<Case> {};
 
 TEST_P(InputTable, NamesFileAndKeyOrLoads) {
   const Case& c = GetParam();
-  TempDir dir;
+  TempDir dir{"tippe-input"};
   const std::string path = dir.write(c.file_name.empty() ? std::string(c.name) + ".toml" : c.file_name, c.text);
   const std::string msg = error_of([&] { load_scene(path, c.overrides); });
   // The in-memory parser (what the fuzzer drives) says exactly what load_scene says.
@@ -444,7 +422,7 @@ Outcome run_tippe(const std::vector<std::string>& args, const fs::path& err_file
 }
 
 TEST(FileTable, BasesAreValidAndEveryKindIsCovered) {
-  TempDir dir;
+  TempDir dir{"tippe-input"};
   const std::string scene = dir.write("scenes/base.toml", kBase);
   const std::string sweep = dir.write("sweeps/base.toml", kSweepBase);
   const std::string gate = dir.write("gates/base.toml", kGateBase);
@@ -466,7 +444,7 @@ class FileTable : public ::testing::TestWithParam<FileCase> {};
 
 TEST_P(FileTable, ThrowsSceneErrorNamingFileKeyAndValue) {
   const FileCase& c = GetParam();
-  TempDir dir;
+  TempDir dir{"tippe-input"};
   const std::string path = write_case(dir, c);
   std::string msg;
   try {

@@ -13,6 +13,7 @@
 
 #include "records.h"
 #include "scene_io.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
@@ -54,28 +55,6 @@ std::string edit(const std::string& text, const std::string& from, const std::st
   if (pos == std::string::npos) return text;
   return text.substr(0, pos) + to + text.substr(pos + from.size());
 }
-
-class TempDir {
- public:
-  TempDir() {
-    std::string templ = (fs::temp_directory_path() / "tippe_test_XXXXXX").string();
-    if (!::mkdtemp(templ.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = templ;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = path_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-
- private:
-  fs::path path_;
-};
 
 std::string load_error(const std::string& path, const std::vector<std::string>& overrides = {}) {
   try {
@@ -157,7 +136,7 @@ void PrintTo(const BadScene& c, std::ostream* os) { *os << c.name; }
 class BadSceneTest : public ::testing::TestWithParam<BadScene> {};
 
 TEST_P(BadSceneTest, NamesFileAndKey) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const BadScene& c = GetParam();
   const std::string path = dir.write(std::string(c.name) + ".toml", c.text);
   const std::string msg = load_error(path, c.overrides);
@@ -174,7 +153,7 @@ INSTANTIATE_TEST_SUITE_P(Malformed, BadSceneTest, ::testing::ValuesIn(bad_scenes
                          [](const ::testing::TestParamInfo<BadScene>& info) { return std::string(info.param.name); });
 
 TEST(SceneIo, SyntaxErrorGivesLineAndColumn) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string base = kBase;
   const auto line = 1 + std::count(base.begin(), base.begin() + static_cast<long>(base.find("tilt = 0.1")), '\n');
   const std::string path = dir.write("syntax.toml", edit(base, "tilt = 0.1", "tilt = = 0.1"));
@@ -183,13 +162,13 @@ TEST(SceneIo, SyntaxErrorGivesLineAndColumn) {
 }
 
 TEST(SceneIo, UnreadableFile) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string path = (dir.path() / "missing.toml").string();
   EXPECT_EQ(load_error(path).rfind(path + ": cannot read", 0), 0u);
 }
 
 TEST(SceneIo, ValidSceneParses) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string text = edit(std::string(kBase), "name = \"base\"\n", "") +
                            "[engines.ode]\ntimestep = 1e-4\niterations = 20\nfinite_rotation = false\nstepper = \"quickstep\"\n";
   const std::string path = dir.write("my_scene.toml", text);
@@ -235,7 +214,7 @@ TEST(SceneIo, ValidSceneParses) {
 }
 
 TEST(SceneIo, OptionalKeysAndOmega) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   std::string text = edit(kBase, "spin = 5.0", "omega = [0.1, 0.2, 5]");
   text = edit(text, "velocity = [0.0, 0.0]\n", "");
   text = edit(text, "rtol = 1e-10\natol = 1e-12\n", "");
@@ -251,7 +230,7 @@ TEST(SceneIo, OptionalKeysAndOmega) {
 }
 
 TEST(SceneIo, BareBallNeedsNoStem) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   std::string text = edit(kBase, "stem_radius = 0.25\nstem_length = 1.2\n", "");
   text = edit(text, "k = 1.0", "k = 1.0\nstem = false");
   const Scene s = load_scene(dir.write("ball.toml", text));
@@ -260,7 +239,7 @@ TEST(SceneIo, BareBallNeedsNoStem) {
 }
 
 TEST(SceneIo, OverridesApply) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string path = dir.write("ovr.toml", edit(kBase, "\"viscous\"\nk = 1.0", "\"coulomb\"\nmu = 0.3"));
   const Scene s = load_scene(path, {"run.duration=2", "contact.mu = 0.5", "engines.ode.stepper=quickstep",
                                     "engines.ode.timestep=1e-4", "initial.omega_along_contact=true"});
@@ -274,7 +253,7 @@ TEST(SceneIo, OverridesApply) {
 }
 
 TEST(SceneIo, HashIsStableAndSeesOverridesAndBytes) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string path = dir.write("h.toml", kBase);
   const std::string h0 = load_scene(path).content_hash;
   EXPECT_EQ(h0.size(), 16u);
@@ -458,7 +437,7 @@ bool has_temporaries(const fs::path& dir) {
 }
 
 TEST(Records, WriteFileAtomic) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string path = (dir.path() / "summary.json").string();
   write_file_atomic(path, "first\n");
   write_file_atomic(path, "second\n");
@@ -472,7 +451,7 @@ TEST(Records, WriteFileAtomic) {
 }
 
 TEST(Records, CsvRoundTripAndCommit) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string path = (dir.path() / "trajectory.csv").string();
   Observation a = sample(0.1, Surface::Ball, -1.5637593718755574);
   a.state.p_WG = Vec3(1.0 / 3.0, -2e-17, 0.7);
@@ -506,7 +485,7 @@ TEST(Records, CsvRoundTripAndCommit) {
 }
 
 TEST(Records, CsvWithoutCommitLeavesNothing) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string path = (dir.path() / "trajectory.csv").string();
   try {
     CsvTrajectoryWriter w(path);
@@ -600,16 +579,9 @@ int run_tippe(const std::string& args, const fs::path& err_file) {
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 TEST(Cli, MalformedSceneExitsWithTwoAndCreatesNothing) {
   ASSERT_TRUE(fs::exists(std::string(TIPPE_BINARY_DIR) + "/tippe")) << "build the tippe target first";
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string scene = dir.write("bad.toml", edit(kBase, "stem_radius = 0.25", "stem_radius = -0.25"));
   const fs::path out = dir.path() / "out";
   const fs::path err = dir.path() / "stderr.txt";
@@ -624,7 +596,7 @@ TEST(Cli, MalformedSceneExitsWithTwoAndCreatesNothing) {
 }
 
 TEST(Cli, UnknownEngineAndMissingFileExitWithTwo) {
-  TempDir dir;
+  TempDir dir{"tippe-test"};
   const std::string scene = dir.write("ok.toml", kBase);
   const fs::path out = dir.path() / "out";
   const fs::path err = dir.path() / "stderr.txt";

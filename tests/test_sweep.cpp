@@ -17,41 +17,13 @@
 
 #include "scene_io.h"
 #include "sweep.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
 
 namespace {
-
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "tippe-sweep-XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void spit(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-}
 
 const std::string kSource = std::string(TIPPE_SOURCE_DIR);
 const std::string kBinary = std::string(TIPPE_BINARY_DIR) + "/tippe";
@@ -162,7 +134,7 @@ TEST(SweepRecords, PartialLastLineIsDetectedAndDropped) {
   EXPECT_EQ(complete_lines_length("one\ntwo\n"), 8u);
   EXPECT_EQ(complete_lines_length("one\ntwo\nthr"), 8u);
 
-  TempDir dir;
+  TempDir dir{"tippe-sweep"};
   const fs::path file = dir.path() / "records.jsonl";
   EXPECT_TRUE(read_records(file.string()).records.empty()) << "a missing file is empty";
   SweepRecord a = sample_record(), b = sample_record();
@@ -185,7 +157,7 @@ TEST(SweepRecords, PartialLastLineIsDetectedAndDropped) {
 }
 
 TEST(SweepRecords, ACorruptCompleteLineNamesFileAndLine) {
-  TempDir dir;
+  TempDir dir{"tippe-sweep"};
   const fs::path file = dir.path() / "records.jsonl";
   spit(file, to_jsonl(sample_record()) + "{\"format\": \"tippe-sweep-record-1\"}\n");
   try {
@@ -373,7 +345,7 @@ TEST(SweepFiles, ShippedSweepsLoad) {
 }
 
 TEST(SweepFiles, PointsCarryTheirOverrides) {
-  TempDir dir;
+  TempDir dir{"tippe-sweep"};
   const fs::path p =
       write_sweep(dir.path(), kGoodHead +
                                   "[[setup]]\nname = \"mj\"\nengine = \"mujoco\"\n"
@@ -389,7 +361,7 @@ TEST(SweepFiles, PointsCarryTheirOverrides) {
 }
 
 TEST(SweepFiles, InvalidFilesNameFileAndKey) {
-  TempDir dir;
+  TempDir dir{"tippe-sweep"};
   struct Case {
     std::string body, key;
   };
@@ -505,7 +477,7 @@ std::map<std::string, json> by_id(const std::vector<SweepRecord>& records, size_
 
 TEST(SweepCli, KilledSweepResumesToTheSameRecords) {
   ASSERT_TRUE(fs::exists(kBinary)) << "build the tippe target first";
-  TempDir dir;
+  TempDir dir{"tippe-sweep"};
   const fs::path whole = dir.path() / "whole", killed = dir.path() / "killed", err = dir.path() / "err.txt";
   const size_t n_points = load_sweep(kSmoke).points.size();
 
@@ -568,7 +540,7 @@ TEST(SweepCli, KilledSweepResumesToTheSameRecords) {
 }
 
 TEST(SweepCli, ChangedSweepFileIsRefusedUnlessRestarted) {
-  TempDir dir;
+  TempDir dir{"tippe-sweep"};
   const fs::path out = dir.path() / "out", err = dir.path() / "err.txt";
   const std::string body = kGoodHead + kGoodSetup;
   const fs::path sweep = write_sweep(dir.path(), body);
@@ -591,7 +563,7 @@ TEST(SweepCli, ChangedSweepFileIsRefusedUnlessRestarted) {
 }
 
 TEST(SweepCli, InvalidSweepExitsWithTwoAndWritesNothing) {
-  TempDir dir;
+  TempDir dir{"tippe-sweep"};
   const fs::path out = dir.path() / "out", err = dir.path() / "err.txt";
   const fs::path bad =
       write_sweep(dir.path(), kGoodHead +
