@@ -189,3 +189,14 @@ TEST(ExtremesStart, InvertedStartRestsOnTheStem) {
   EXPECT_NEAR(ref.forces().normal[1], m.M * m.g, 0.1 * m.M * m.g);
   EXPECT_EQ(ref.forces().normal[0], 0.0);
 }
+
+// The tilt keeps its digits at both ends (it was acos of e_Z.z, which reads a tilt of 1e-9 as 0:
+// cos = 1 - 5e-19 rounds to 1). 1e-15 relative: a few rounding errors of the rotation.
+TEST(ExtremesStart, TiltIsExactNearVerticalAndInverted) {
+  for (double t : {1e-12, 1e-9, 1e-4, 0.1, 1.5, 3.0}) {
+    EXPECT_NEAR(tilt(Quat(Eigen::AngleAxisd(t, Vec3::UnitX()))), t, 1e-15 * t) << t;
+    const double u = 3.14159265358979323846 - t;
+    EXPECT_NEAR(tilt(Quat(Eigen::AngleAxisd(u, Vec3::UnitX()))), u, 1e-15 * u) << u;
+  }
+  EXPECT_EQ(tilt(Quat::Identity()), 0.0);
+}
