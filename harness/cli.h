@@ -1,12 +1,16 @@
 // Shared pieces of the `tippe` subcommands: how one registers, how errors map to exit codes.
 #pragma once
 
+#include <exception>
 #include <functional>
+#include <iostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+
+#include "scene_io.h"
 
 namespace tippe::cli {
 
@@ -25,6 +29,23 @@ struct Command {
   Action action;
 };
 using Setup = Command (*)(CLI::App& app);
+
+// A subcommand's exception as an exit code (SceneError, UsageError -> 2, anything else -> 1),
+// its message on stderr when `print`.
+inline int error_exit(const std::exception_ptr& e, bool print = true) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const SceneError& x) {
+    if (print) std::cerr << "tippe: error: " << x.what() << "\n";
+    return 2;
+  } catch (const UsageError& x) {
+    if (print) std::cerr << "tippe: error: " << x.what() << "\n";
+    return 2;
+  } catch (const std::exception& x) {
+    if (print) std::cerr << "tippe: error: internal: " << x.what() << "\n";
+    return 1;
+  }
+}
 
 // One function per subcommand, each in its own cli_NAME.cpp; main.cpp lists them.
 Command setup_run(CLI::App& app);

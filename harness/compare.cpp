@@ -15,6 +15,7 @@
 #include <memory>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 #include <unistd.h>
@@ -580,18 +581,38 @@ bool load_cached_reference(const fs::path& dir, const Scene& scene, const std::s
   const fs::path summary = dir / "summary.json", csv = dir / "trajectory.csv";
   std::error_code ec;
   if (!fs::exists(summary, ec) || !fs::exists(csv, ec)) return false;
+  std::string summary_text, csv_text;
   try {
-    std::ifstream in(summary);
-    const RunRecord r = from_json(json::parse(in));
-    if (r.engine != "analytic" || physics_hash(r.scene_spec) != hash) return false;
-    if (r.provenance.git_commit != build_info().git_commit || r.engine_version != analytic_version(scene)) return false;
-    Trajectory tr = Trajectory::from_csv(read_trajectory_csv(csv.string()));
-    if (static_cast<long long>(tr.size()) != r.samples) return false;
+    summary_text = read_file_text(summary.string());
+    csv_text = read_file_text(csv.string());
+  } catch (const std::runtime_error&) {
+    return false;
+  }
+  return reference_from_text(summary_text, csv_text, scene, hash, dir.string(), record, trajectory).empty();
+}
+
+std::string reference_from_text(const std::string& summary_json, const std::string& trajectory_csv,
+                                const Scene& scene, const std::string& hash, const std::string& where,
+                                RunRecord& record, Trajectory& trajectory) {
+  try {
+    const RunRecord r = from_json(json::parse(summary_json));
+    if (r.engine != "analytic") return where + ": not a reference run (engine " + r.engine + ")";
+    if (physics_hash(r.scene_spec) != hash) return where + ": made from other physics";
+    if (r.provenance.git_commit != build_info().git_commit)
+      return where + ": made by the build of commit " + r.provenance.git_commit + ", this is " +
+             build_info().git_commit;
+    if (r.engine_version != analytic_version(scene))
+      return where + ": made by reference version " + r.engine_version + ", this is " + analytic_version(scene);
+    std::istringstream in(trajectory_csv);
+    Trajectory tr = Trajectory::from_csv(parse_trajectory_csv(in, where + "/trajectory.csv"));
+    if (static_cast<long long>(tr.size()) != r.samples)
+      return where + ": trajectory has " + std::to_string(tr.size()) + " samples, the summary " +
+             std::to_string(r.samples);
     record = r;
     trajectory = std::move(tr);
-    return true;
-  } catch (const std::exception&) {
-    return false;
+    return "";
+  } catch (const std::exception& e) {
+    return where + ": " + e.what();
   }
 }
 

@@ -129,5 +129,10 @@ std::string physics_hash(const nlohmann::json& scene_json);
 // build of the reference (same commit, same version string); false for anything else.
 bool load_cached_reference(const std::filesystem::path& dir, const Scene& scene, const std::string& hash,
                            RunRecord& record, Trajectory& trajectory);
+// The same rule over the two files' texts (a reference sent from another process); `where`
+// names their origin in the reason. Empty: accepted; otherwise why not.
+std::string reference_from_text(const std::string& summary_json, const std::string& trajectory_csv,
+                                const Scene& scene, const std::string& hash, const std::string& where,
+                                RunRecord& record, Trajectory& trajectory);
 
 }  // namespace tippe

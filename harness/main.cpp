@@ -32,14 +32,7 @@ int main(int argc, char** argv) {
 
   try {
     return actions.at(app.get_subcommands().front())();
-  } catch (const SceneError& e) {
-    std::cerr << "tippe: error: " << e.what() << "\n";
-    return 2;
-  } catch (const cli::UsageError& e) {
-    std::cerr << "tippe: error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "tippe: error: internal: " << e.what() << "\n";
-    return 1;
+  } catch (const std::exception&) {
+    return cli::error_exit(std::current_exception());
   }
 }

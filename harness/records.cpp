@@ -314,6 +314,15 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   }
 }
 
+std::string read_file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot read: " + errno_text());
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw std::runtime_error(path + ": cannot read: " + errno_text());
+  return ss.str();
+}
+
 const std::vector<std::string>& trajectory_columns() {
   static const std::vector<std::string> cols = {
       "t",        "x_G",        "y_G",        "z_G",        "vx_G",         "vy_G",       "vz_G",
@@ -328,10 +337,7 @@ CsvTrajectoryWriter::CsvTrajectoryWriter(std::string path) : path_(std::move(pat
   if (!f_) throw std::runtime_error(path_ + ": cannot write: " + errno_text());
   buffer_.resize(1 << 20);
   std::setvbuf(f_, buffer_.data(), _IOFBF, buffer_.size());
-  std::string header;
-  for (const auto& c : trajectory_columns()) header += (header.empty() ? "" : ",") + c;
-  header += '\n';
-  if (std::fputs(header.c_str(), f_) == EOF) fail("cannot write");
+  if (std::fputs(trajectory_csv_header().c_str(), f_) == EOF) fail("cannot write");
 }
 
 CsvTrajectoryWriter::~CsvTrajectoryWriter() {
@@ -349,11 +355,9 @@ void CsvTrajectoryWriter::fail(const std::string& what) {
   throw std::runtime_error(path_ + ": " + what + ": " + why);
 }
 
-void CsvTrajectoryWriter::write(const Observation& o) {
-  if (!f_) throw std::logic_error(path_ + ": write after commit");
-  char line[27 * 32];
+size_t format_trajectory_row(const Observation& o, char* line) {
   char* p = line;
-  char* const end = line + sizeof line;
+  char* const end = line + kTrajectoryRowMax;
   auto put = [&](double v) {
     if (p != line) *p++ = ',';
     p = std::to_chars(p, end, v, std::chars_format::general, 17).ptr;
@@ -382,7 +386,27 @@ void CsvTrajectoryWriter::write(const Observation& o) {
   put(o.jellett);
   put(o.contact_latitude);
   *p++ = '\n';
-  if (std::fwrite(line, 1, static_cast<size_t>(p - line), f_) != static_cast<size_t>(p - line)) fail("cannot write");
+  return static_cast<size_t>(p - line);
+}
+
+std::string trajectory_csv_header() {
+  std::string header;
+  for (const auto& c : trajectory_columns()) header += (header.empty() ? "" : ",") + c;
+  return header + '\n';
+}
+
+void CsvTrajectoryWriter::write(const Observation& o) {
+  if (!f_) throw std::logic_error(path_ + ": write after commit");
+  char line[kTrajectoryRowMax];
+  const size_t n = format_trajectory_row(o, line);
+  if (std::fwrite(line, 1, n, f_) != n) fail("cannot write");
+}
+
+CsvTrajectoryText::CsvTrajectoryText() : text(trajectory_csv_header()) {}
+
+void CsvTrajectoryText::write(const Observation& o) {
+  char line[kTrajectoryRowMax];
+  text.append(line, format_trajectory_row(o, line));
 }
 
 void CsvTrajectoryWriter::commit() {
@@ -407,6 +431,10 @@ const std::vector<double>& CsvTrajectory::column(const std::string& name) const 
 CsvTrajectory read_trajectory_csv(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot read: " + errno_text());
+  return parse_trajectory_csv(in, path);
+}
+
+CsvTrajectory parse_trajectory_csv(std::istream& in, const std::string& path) {
   auto split = [](const std::string& line) {
     std::vector<std::string> cells;
     std::stringstream ss(line);

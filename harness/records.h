@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <functional>
+#include <istream>
 #include <map>
 #include <optional>
 #include <string>
@@ -105,6 +106,8 @@ long long json_integer(const nlohmann::json& j, const char* key);
 // Writes `text` to `path.tmp.PID`, fsyncs it and renames it over `path`, so readers see the old
 // file or the new one, never a part. Throws std::runtime_error (temporary removed) on failure.
 void write_file_atomic(const std::string& path, const std::string& text);
+// A whole file's bytes; throws std::runtime_error "PATH: cannot read: reason".
+std::string read_file_text(const std::string& path);
 
 // The trajectory columns, in file order.
 const std::vector<std::string>& trajectory_columns();
@@ -130,6 +133,20 @@ class CsvTrajectoryWriter : public SampleSink {
   std::vector<char> buffer_;
 };
 
+// The CSV text of a trajectory, kept in memory (a reference sent between processes).
+class CsvTrajectoryText : public SampleSink {
+ public:
+  CsvTrajectoryText();
+  void write(const Observation& o) override;
+  std::string text;  // header and every row so far
+};
+
+// One row of trajectory.csv ('\n' included) into `line`, which holds kTrajectoryRowMax chars;
+// its length. Every number has 17 significant digits, so it reads back to the same double.
+constexpr size_t kTrajectoryRowMax = 27 * 32;
+size_t format_trajectory_row(const Observation& o, char* line);
+std::string trajectory_csv_header();  // '\n' included
+
 // A trajectory.csv read back: numeric columns by name, surface as Surface codes (0..3).
 struct CsvTrajectory {
   std::vector<std::string> columns;  // header order
@@ -141,5 +158,7 @@ struct CsvTrajectory {
 };
 // Throws std::runtime_error "FILE:LINE: reason" for a file that is not a trajectory.
 CsvTrajectory read_trajectory_csv(const std::string& path);
+// The same from a stream; `name` stands for the file in messages.
+CsvTrajectory parse_trajectory_csv(std::istream& in, const std::string& name);
 
 }  // namespace tippe

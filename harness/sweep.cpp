@@ -29,6 +29,7 @@
 #include <thread>
 
 #include "classify.h"
+#include "dir_lock.h"
 #include "provenance.h"
 #include "records.h"
 #include "scene_io.h"
@@ -641,20 +642,49 @@ bool load_reference(const fs::path& dir, const Scene& scene, const std::string& 
   return ref.cached;
 }
 
-// Runs the reference at the scene's own tolerances into the cache; the summary goes last, so its
-// presence says the trajectory beside it is complete.
-void compute_reference(const fs::path& dir, const Scene& scene, Reference& ref) {
-  fs::create_directories(dir);
-  CsvTrajectoryWriter csv((dir / "trajectory.csv").string());
+// The reference's two cache files as texts, "summary.json" then "trajectory.csv", each behind its
+// length: what a worker sends back and what the coordinator shares with every rank.
+std::string pack_texts(const std::string& summary, const std::string& csv) {
+  return std::to_string(summary.size()) + "\n" + summary + std::to_string(csv.size()) + "\n" + csv;
+}
+// Reads one pack_texts pair at `pos` (advanced past it); throws std::runtime_error when cut short.
+std::pair<std::string, std::string> unpack_texts(const std::string& bytes, size_t& pos) {
+  auto field = [&]() {
+    const size_t nl = bytes.find('\n', pos);
+    if (nl == std::string::npos) throw std::runtime_error("reference message cut short");
+    const size_t n = std::stoull(bytes.substr(pos, nl - pos));
+    if (nl + 1 + n > bytes.size()) throw std::runtime_error("reference message cut short");
+    std::string text = bytes.substr(nl + 1, n);
+    pos = nl + 1 + n;
+    return text;
+  };
+  std::string summary = field();
+  return {std::move(summary), field()};
+}
+
+// Runs the reference at the scene's own tolerances, on whichever process the task lands.
+std::string compute_reference_texts(const Scene& scene) {
+  CsvTrajectoryText csv;
   TrajectorySink sink({&csv});
   auto sim = make_simulator("analytic", scene);
-  ref.record = run_simulator(*sim, scene, &sink);
+  const RunRecord record = run_simulator(*sim, scene, &sink);
   sim.reset();
-  if (ref.record.status == to_string(RunStatus::Failed) || sink.trajectory.size() == 0)
-    throw std::runtime_error("reference run of " + scene.name + " failed: " + ref.record.status_detail);
-  csv.commit();
-  write_file_atomic((dir / "summary.json").string(), to_json(ref.record).dump(2) + "\n");
-  ref.trajectory = std::move(sink.trajectory);
+  if (record.status == to_string(RunStatus::Failed) || sink.trajectory.size() == 0)
+    throw std::runtime_error("reference run of " + scene.name + " failed: " + record.status_detail);
+  return pack_texts(to_json(record).dump(2) + "\n", csv.text);
+}
+
+// Into the cache (the summary last, so that its presence says the trajectory beside it is
+// complete) and into memory, read back from the very texts every other rank will read.
+void store_reference(const fs::path& dir, const Scene& scene, const std::string& hash, const std::string& texts,
+                     Reference& ref) {
+  size_t pos = 0;
+  const auto [summary, csv] = unpack_texts(texts, pos);
+  fs::create_directories(dir);
+  write_file_atomic((dir / "trajectory.csv").string(), csv);
+  write_file_atomic((dir / "summary.json").string(), summary);
+  const std::string why = reference_from_text(summary, csv, scene, hash, dir.string(), ref.record, ref.trajectory);
+  if (!why.empty()) throw std::runtime_error("reference of " + scene.name + " does not read back: " + why);
 }
 
 json settings_object(const SettingsList& s) {
@@ -784,11 +814,15 @@ std::string clock_text(double seconds) {
 // short point overestimate every long one.
 class SweepProgress {
  public:
-  SweepProgress(const SweepPlan& plan, std::vector<size_t> todo, size_t skipped, int jobs)
+  // total: the points of this run's share (the whole plan, or a shard's); lines: one full line
+  // every 10 s instead of redrawing one (stderr passed on by an MPI launcher).
+  SweepProgress(const SweepPlan& plan, std::vector<size_t> todo, size_t total, size_t skipped, int jobs, bool lines)
       : plan_(plan),
         todo_(std::move(todo)),
+        total_(total),
         skipped_(skipped),
         jobs_(jobs),
+        lines_(lines),
         start_(now()),
         started_(plan.points.size(), -1.0),
         finished_(plan.points.size(), false) {}
@@ -807,8 +841,10 @@ class SweepProgress {
   void print(bool final_line) {
     std::lock_guard<std::mutex> lock(m_);
     const double elapsed = now() - start_;
+    if (lines_ && !final_line && elapsed - last_line_ < 10.0) return;
+    last_line_ = elapsed;
     char buf[160];
-    std::snprintf(buf, sizeof buf, "[sweep] %zu/%zu points", done_ + skipped_, plan_.points.size());
+    std::snprintf(buf, sizeof buf, "[sweep] %zu/%zu points", done_ + skipped_, total_);
     std::string line = buf;
     if (skipped_) line += " (" + std::to_string(skipped_) + " from an earlier run)";
     size_t running = 0;
@@ -818,6 +854,11 @@ class SweepProgress {
     if (!final_line) {
       const double left = estimate_left(elapsed);
       line += std::isfinite(left) ? " | ~" + clock_text(left) + " left" : " | estimating";
+    }
+    if (lines_) {
+      std::fprintf(stderr, "%s\n", line.c_str());
+      std::fflush(stderr);
+      return;
     }
     const size_t len = line.size();
     if (line.size() < width_) line.append(width_ - line.size(), ' ');
@@ -872,8 +913,10 @@ class SweepProgress {
 
   const SweepPlan& plan_;
   std::vector<size_t> todo_;
-  size_t skipped_;
+  size_t total_, skipped_;
   int jobs_;
+  bool lines_;
+  double last_line_ = -1e9;
   double start_;
   std::mutex m_;
   std::vector<double> started_;
@@ -923,67 +966,15 @@ class RecordAppender {
   std::mutex m_;
 };
 
-// Holds an exclusive lock on DIR/.lock for the life of a run, so two sweeps never append to the
-// same records.
-class DirLock {
- public:
-  explicit DirLock(const fs::path& dir) {
-    const std::string path = (dir / ".lock").string();
-    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw std::runtime_error(path + ": cannot open: " + std::strerror(errno));
-    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      ::close(fd_);
-      fd_ = -1;
-      throw SweepInputError(dir.string() + ": in use by another tippe sweep");
-    }
-  }
-  ~DirLock() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  DirLock(const DirLock&) = delete;
-  DirLock& operator=(const DirLock&) = delete;
 
- private:
-  int fd_ = -1;
-};
-
-// Runs fn(0..n-1) on `jobs` threads; the first exception is rethrown after every thread ends.
-void parallel_for(size_t n, int jobs, const std::function<void(size_t)>& fn, const std::function<void()>& idle = {}) {
-  std::atomic<size_t> next{0}, finished{0};
-  std::exception_ptr error;
-  std::mutex error_m;
-  std::atomic<bool> stop{false};
-  auto worker = [&] {
-    for (size_t k; !stop.load() && (k = next.fetch_add(1)) < n;) {
-      try {
-        fn(k);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_m);
-        if (!error) error = std::current_exception();
-        stop.store(true);
-      }
-      finished.fetch_add(1);
-    }
-  };
-  const size_t threads = std::min(static_cast<size_t>(std::max(jobs, 1)), std::max<size_t>(n, 1));
-  std::vector<std::thread> pool;
-  for (size_t i = 0; i < threads; ++i) pool.emplace_back(worker);
-  if (idle) {
-    // Five redraws a second; the short naps end the wait soon after the last task.
-    auto last = std::chrono::steady_clock::now() - std::chrono::seconds(1);
-    while (finished.load() < n && !stop.load()) {
-      if (std::chrono::steady_clock::now() - last >= std::chrono::milliseconds(200)) {
-        idle();
-        last = std::chrono::steady_clock::now();
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-  }
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+json shard_json(const SweepPlan& plan, const std::optional<SweepShard>& shard, const std::vector<size_t>& share) {
+  if (!shard) return nullptr;
+  json ids = json::array();
+  for (size_t i : share) ids.push_back(plan.points[i].id);
+  return json{{"index", shard->index}, {"count", shard->count}, {"point_ids", ids}};
 }
 
-json sweep_json(const SweepPlan& plan) {
+json sweep_json(const SweepPlan& plan, const json& shard) {
   const Provenance p = current_provenance();
   json scenes = json::array(), setups = json::array();
   for (const Scene& s : plan.scenes) scenes.push_back(s.name);
@@ -998,6 +989,7 @@ json sweep_json(const SweepPlan& plan) {
               {"scenes", scenes},
               {"setups", setups},
               {"sweep_text", plan.spec.text},
+              {"shard", shard},
               {"provenance",
                {{"git_commit", p.git_commit},
                 {"compiler", p.compiler},
@@ -1006,13 +998,68 @@ json sweep_json(const SweepPlan& plan) {
                 {"hostname", p.hostname}}}};
 }
 
-}  // namespace
 
-SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o) {
+std::string shard_text(const json& shard) {
+  if (shard.is_null()) return "the whole sweep";
+  return "shard " + std::to_string(shard.at("index").get<int>()) + "/" + std::to_string(shard.at("count").get<int>());
+}
+
+// What the coordinator found in OUT and decided, shared with every rank: which points run, in
+// which order, and which references must be computed.
+struct Prepared {
+  std::vector<size_t> todo;        // indices into plan.points, in the order they are handed out
+  std::vector<size_t> needed;      // scenes with a point in todo
+  std::vector<size_t> to_compute;  // of those, the ones not in the cache
+  size_t share = 0, skipped = 0, cached = 0, partial_bytes = 0;
+};
+
+std::string encode(const Prepared& p) {
+  std::ostringstream ss;
+  auto list = [&](const std::vector<size_t>& v) {
+    ss << v.size();
+    for (size_t x : v) ss << ' ' << x;
+    ss << '\n';
+  };
+  ss << p.share << ' ' << p.skipped << ' ' << p.cached << ' ' << p.partial_bytes << '\n';
+  list(p.todo);
+  list(p.needed);
+  list(p.to_compute);
+  return ss.str();
+}
+
+Prepared decode(const std::string& bytes) {
+  std::istringstream ss(bytes);
+  Prepared p;
+  auto list = [&](std::vector<size_t>& v) {
+    size_t n = 0;
+    ss >> n;
+    v.resize(n);
+    for (size_t& x : v) ss >> x;
+  };
+  ss >> p.share >> p.skipped >> p.cached >> p.partial_bytes;
+  list(p.todo);
+  list(p.needed);
+  list(p.to_compute);
+  if (!ss) throw std::runtime_error("MPI: the coordinator's plan message is cut short");
+  return p;
+}
+
+// The coordinator's half of the start: checks OUT, takes its lock, recovers records.jsonl and
+// decides what runs. Throws SweepInputError before anything is written.
+Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<DirLock>& lock,
+                 std::vector<Reference>& refs) {
   if (o.jobs < 1) throw SweepInputError("jobs must be at least 1, got " + std::to_string(o.jobs));
   if (o.out_dir.empty()) throw SweepInputError("no output directory");
   const fs::path out = o.out_dir;
   const fs::path sweep_file = out / "sweep.json", records_file = out / "records.jsonl";
+  std::vector<size_t> share;
+  if (o.shard) {
+    share = shard_points(plan, *o.shard);
+  } else {
+    share.resize(plan.points.size());
+    for (size_t i = 0; i < share.size(); ++i) share[i] = i;
+  }
+  const json shard = shard_json(plan, o.shard, share);
 
   // What OUT holds is checked before anything is written to it.
   bool fresh = true;
@@ -1031,7 +1078,12 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o) {
         throw SweepInputError(sweep_file.string() + ": plan_hash: the physics of a scene of " + plan.spec.file +
                               " changed since " + out.string() +
                               " was started; give --restart to begin it again, or another --out");
-      fresh = h != plan.spec.hash || ph != plan.plan_hash;
+      const json old_shard = old.value("shard", json(nullptr));
+      if (old_shard != shard && h == plan.spec.hash && ph == plan.plan_hash && !o.restart)
+        throw SweepInputError(sweep_file.string() + ": shard: " + out.string() + " holds " + shard_text(old_shard) +
+                              ", this run is " + shard_text(shard) +
+                              "; give each shard its own --out (or --restart to begin it again)");
+      fresh = h != plan.spec.hash || ph != plan.plan_hash || old_shard != shard;
     } catch (const json::exception& e) {
       if (!o.restart)
         throw SweepInputError(sweep_file.string() + ": not a sweep record (" + e.what() +
@@ -1045,17 +1097,17 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o) {
   std::error_code mk;
   fs::create_directories(out, mk);
   if (mk) throw SweepInputError(out.string() + ": cannot create the output directory: " + mk.message());
-  DirLock lock(out);
-  SweepOutcome outcome;
-  outcome.points = plan.points.size();
+  lock = std::make_unique<DirLock>(out);
   if (fresh || o.restart) {
     // Beginning again: earlier records are kept aside, never silently mixed with the new ones.
     if (fs::exists(records_file, ec)) fs::rename(records_file, out / "records.jsonl.old");
-    write_file_atomic(sweep_file.string(), sweep_json(plan).dump(2) + "\n");
+    write_file_atomic(sweep_file.string(), sweep_json(plan, shard).dump(2) + "\n");
   }
 
+  Prepared p;
+  p.share = share.size();
   const RecordsFile existing = recover_records(records_file.string());
-  outcome.partial_bytes_dropped = existing.partial_bytes;
+  p.partial_bytes = existing.partial_bytes;
   if (existing.partial_bytes)
     std::fprintf(stderr, "tippe: %s: dropped a partial last line (%zu bytes); its point runs again\n",
                  records_file.string().c_str(), existing.partial_bytes);
@@ -1067,9 +1119,9 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o) {
                  records_file.string().c_str(), duplicates);
 
   std::vector<size_t> todo;
-  for (size_t i = 0; i < plan.points.size(); ++i)
+  for (size_t i : share)
     if (!done.count(plan.points[i].id)) todo.push_back(i);
-  outcome.skipped = plan.points.size() - todo.size();
+  p.skipped = share.size() - todo.size();
   // The two cheapest points of each setup first: a few seconds in, every setup's overhead and
   // seconds per unit of weight are measured and the time left is a real estimate. Then the
   // longest first, so that the last point to finish is a short one and the cores stay busy.
@@ -1084,52 +1136,173 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o) {
       order.push_back(*it);
       first.insert(*it);
     }
-  for (size_t p : todo)
-    if (!first.count(p)) order.push_back(p);
-  todo = std::move(order);
+  for (size_t q : todo)
+    if (!first.count(q)) order.push_back(q);
+  p.todo = std::move(order);
 
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Reference> refs(plan.scenes.size());
-  std::vector<size_t> needed;
   for (size_t i = 0; i < plan.scenes.size(); ++i)
-    if (std::any_of(todo.begin(), todo.end(), [&](size_t p) { return plan.points[p].scene_index == i; }))
-      needed.push_back(i);
-  std::vector<size_t> to_compute;
-  for (size_t i : needed) {
+    if (std::any_of(p.todo.begin(), p.todo.end(), [&](size_t q) { return plan.points[q].scene_index == i; }))
+      p.needed.push_back(i);
+  for (size_t i : p.needed) {
     const fs::path dir = out / "reference" / plan.physics_hashes[i];
     if (load_reference(dir, plan.scenes[i], plan.physics_hashes[i], refs[i]))
-      ++outcome.references_cached;
+      ++p.cached;
     else
-      to_compute.push_back(i);
+      p.to_compute.push_back(i);
   }
-  if (o.progress && !to_compute.empty())
-    std::fprintf(stderr, "[sweep] computing %zu reference(s)\n", to_compute.size());
-  parallel_for(to_compute.size(), o.jobs, [&](size_t k) {
-    const size_t i = to_compute[k];
-    compute_reference(out / "reference" / plan.physics_hashes[i], plan.scenes[i], refs[i]);
-  });
-  for (size_t i : needed) refs[i].summary = reference_summary(plan.scenes[i], refs[i]);
+  return p;
+}
 
-  if (!todo.empty()) {
-    RecordAppender appender(records_file);
-    SweepProgress progress(plan, todo, outcome.skipped, o.jobs);
-    auto run_one = [&](size_t k) {
-      const size_t p = todo[k];
-      progress.begin(p);
-      const auto start = std::chrono::steady_clock::now();
-      const SweepRecord r = run_point(plan, plan.points[p], refs[plan.points[p].scene_index]);
-      appender.append(to_jsonl(r));
-      progress.end(p, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    };
-    std::function<void()> idle;
-    if (o.progress) idle = [&] { progress.print(false); };
-    parallel_for(todo.size(), o.jobs, run_one, idle);
-    if (o.progress) progress.print(true);
+}  // namespace
+
+SweepShard parse_shard(const std::string& text) {
+  const size_t slash = text.find('/');
+  auto number = [&](const std::string& part, long long& v) {
+    if (part.empty() || part.size() > 9 || !std::all_of(part.begin(), part.end(), ::isdigit)) return false;
+    v = std::stoll(part);
+    return true;
+  };
+  long long i = -1, n = -1;
+  if (slash == std::string::npos || !number(text.substr(0, slash), i) || !number(text.substr(slash + 1), n))
+    throw std::invalid_argument("--shard \"" + text + "\": expected I/N, e.g. 0/4");
+  if (n < 1 || n > 1000000 || i >= n)
+    throw std::invalid_argument("--shard \"" + text + "\": I/N needs 1 <= N <= 1000000 and 0 <= I < N");
+  return SweepShard{static_cast<int>(i), static_cast<int>(n)};
+}
+
+std::vector<size_t> shard_points(const SweepPlan& plan, const SweepShard& shard) {
+  // Longest processing time first: the points by a priori weight, heaviest first (ties in plan
+  // order), each to the shard with the least weight so far (ties to the lowest shard). A pure
+  // function of the plan, so every job of an array computes the same partition.
+  std::vector<size_t> byweight(plan.points.size());
+  for (size_t i = 0; i < byweight.size(); ++i) byweight[i] = i;
+  std::vector<double> w(plan.points.size());
+  for (size_t i = 0; i < w.size(); ++i) w[i] = point_weight(plan, plan.points[i]);
+  std::stable_sort(byweight.begin(), byweight.end(), [&](size_t a, size_t b) { return w[a] > w[b]; });
+  std::vector<double> load(static_cast<size_t>(shard.count), 0.0);
+  std::vector<size_t> mine;
+  for (size_t i : byweight) {
+    const size_t s = static_cast<size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    load[s] += w[i];
+    if (s == static_cast<size_t>(shard.index)) mine.push_back(i);
   }
-  outcome.ran = todo.size();
+  std::sort(mine.begin(), mine.end());
+  return mine;
+}
+
+SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o) {
+  auto farm = make_thread_farm(o.jobs);
+  return run_sweep(plan, o, *farm);
+}
+
+SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& farm) {
+  const fs::path out = o.out_dir;
+  const fs::path records_file = out / "records.jsonl";
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Reference> refs(plan.scenes.size());
+
+  // 1. The coordinator decides; its decision (or its refusal) reaches every rank.
+  std::unique_ptr<DirLock> lock;
+  Prepared prep;
+  std::string message;
+  if (farm.coordinator()) {
+    try {
+      prep = prepare(plan, o, lock, refs);
+      message = "ok\n" + encode(prep);
+    } catch (const SweepInputError& e) {
+      message = std::string("input\n") + e.what();
+    } catch (const std::exception& e) {
+      message = std::string("error\n") + e.what();
+    }
+  }
+  farm.broadcast(message);
+  const size_t nl = message.find('\n');
+  const std::string kind = message.substr(0, nl), rest = message.substr(nl + 1);
+  if (kind == "input") throw SweepInputError(rest);
+  if (kind != "ok") throw std::runtime_error(rest);
+  if (!farm.coordinator()) prep = decode(rest);
+
+  SweepOutcome outcome;
+  outcome.points = prep.share;
+  outcome.skipped = prep.skipped;
+  outcome.references_cached = prep.cached;
+  outcome.partial_bytes_dropped = prep.partial_bytes;
+
+  // 2. Each missing reference is computed once, wherever a worker is free; the coordinator caches it.
+  if (farm.coordinator() && o.progress && !prep.to_compute.empty())
+    std::fprintf(stderr, "[sweep] computing %zu reference(s)\n", prep.to_compute.size());
+  farm.run(
+      prep.to_compute.size(), [&](size_t k) { return compute_reference_texts(plan.scenes[prep.to_compute[k]]); },
+      [&](size_t k, std::string&& texts) {
+        const size_t i = prep.to_compute[k];
+        store_reference(out / "reference" / plan.physics_hashes[i], plan.scenes[i], plan.physics_hashes[i], texts,
+                        refs[i]);
+      });
+
+  // 3. Every rank gets the same texts of every reference it needs, and reads them the way the cache is read.
+  if (farm.distributed()) {
+    std::string bytes;
+    if (farm.coordinator())
+      for (size_t i : prep.needed) {
+        const fs::path dir = out / "reference" / plan.physics_hashes[i];
+        bytes += pack_texts(read_file_text((dir / "summary.json").string()),
+                             read_file_text((dir / "trajectory.csv").string()));
+      }
+    farm.broadcast(bytes);
+    std::string error;
+    if (!farm.coordinator()) {
+      try {
+        size_t pos = 0;
+        for (size_t i : prep.needed) {
+          const auto [summary, csv] = unpack_texts(bytes, pos);
+          const std::string why = reference_from_text(summary, csv, plan.scenes[i], plan.physics_hashes[i],
+                                                      "the reference of " + plan.scenes[i].name + " from rank 0",
+                                                      refs[i].record, refs[i].trajectory);
+          if (!why.empty()) throw std::runtime_error(why);
+        }
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+    }
+    error = first_error(farm, error);
+    if (!error.empty()) throw std::runtime_error(error);
+  }
+  for (size_t i : prep.needed) refs[i].summary = reference_summary(plan.scenes[i], refs[i]);
+
+  // 4. The points: each runs once, on some worker; the coordinator appends its line.
+  if (!prep.todo.empty()) {
+    std::unique_ptr<RecordAppender> appender;
+    std::unique_ptr<SweepProgress> progress;
+    std::vector<std::chrono::steady_clock::time_point> started(prep.todo.size());
+    if (farm.coordinator()) {
+      appender = std::make_unique<RecordAppender>(records_file);
+      progress = std::make_unique<SweepProgress>(plan, prep.todo, prep.share, prep.skipped, farm.workers(),
+                                                 farm.distributed());
+    }
+    TaskFarm::Idle idle;
+    if (o.progress && farm.coordinator()) idle = [&] { progress->print(false); };
+    farm.run(
+        prep.todo.size(),
+        [&](size_t k) {
+          const size_t p = prep.todo[k];
+          return to_jsonl(run_point(plan, plan.points[p], refs[plan.points[p].scene_index]));
+        },
+        [&](size_t k, std::string&& line) {
+          appender->append(line);
+          progress->end(prep.todo[k],
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - started[k]).count());
+        },
+        [&](size_t k) {
+          started[k] = std::chrono::steady_clock::now();
+          progress->begin(prep.todo[k]);
+        },
+        idle);
+    if (o.progress && farm.coordinator()) progress->print(true);
+  }
+  outcome.ran = prep.todo.size();
   outcome.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  write_sweep_report(out.string(), read_records(records_file.string()).records, o.plots);
+  if (farm.coordinator()) write_sweep_report(out.string(), read_records(records_file.string()).records, o.plots);
   return outcome;
 }
 

@@ -11,6 +11,7 @@
 
 #include "compare.h"
 #include "scene.h"
+#include "task_farm.h"
 
 namespace tippe {
 
@@ -147,8 +148,19 @@ RecordsFile recover_records(const std::string& path);
 
 // ---- running ----------------------------------------------------------------------------------
 
+// One of N deterministic shares of a sweep's points (`--shard I/N`), for job arrays.
+struct SweepShard {
+  int index = 0, count = 1;
+};
+// "I/N" with 0 <= I < N <= 1000000; throws std::invalid_argument quoting the text.
+SweepShard parse_shard(const std::string& text);
+// The indices into plan.points of shard I of N, increasing. The shares partition the points and
+// balance their a priori cost (longest processing time first); a pure function of the plan.
+std::vector<size_t> shard_points(const SweepPlan& plan, const SweepShard& shard);
+
 struct SweepOptions {
   std::string out_dir;
+  std::optional<SweepShard> shard;  // only this share of the points (sweep.json records which)
   int jobs = 1;
   bool restart = false;  // a DIR started with another sweep file (or other scene physics) is begun again
   bool progress = true;  // progress line with the time left on stderr
@@ -175,6 +187,23 @@ struct SweepOutcome {
 // trajectory.csv}, report.md, index.html, *.svg. Throws SweepInputError before anything is
 // written; an engine that diverges or throws is a point with that status, not an error.
 SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& options);
+// The same over a farm of processes (every rank calls it; task_farm.h): the coordinator does all
+// of the above that touches OUT; each missing reference is computed by one worker and shared with
+// every rank; the points are handed out one at a time. options.jobs is not used. Records are those
+// of a local run (apart from timings and order).
+SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& options, TaskFarm& farm);
+
+// `tippe sweep --merge`: shard directories of one sweep into one directory, as if run whole:
+// sweep.json without a shard, records.jsonl in plan order, the references, the report. Refuses
+// (SweepInputError naming the directory and the reason) shards of another sweep file or plan, of
+// another shard count, a missing or repeated shard, a shard with unfinished or foreign points, an
+// output directory that is one of the shards or holds another sweep.
+struct MergeOutcome {
+  size_t shards = 0, points = 0;
+  std::vector<std::string> warnings;
+};
+MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std::string& out_dir, bool restart,
+                          bool plots);
 
 // ---- analysis (pure functions of records) -----------------------------------------------------
 

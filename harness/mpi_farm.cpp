@@ -1,0 +1,225 @@
+// Tasks over MPI ranks: rank 0 hands out task indices one at a time as workers ask, and receives every result.
+#include "mpi_farm.h"
+
+#include <mpi.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace tippe {
+
+namespace {
+
+// Message tags. A worker's result doubles as its request for the next task, so each task costs
+// one round trip.
+enum Tag : int {
+  kResult = 1,  // worker -> 0: int64 task (-1: none yet), then the result's bytes
+  kError = 2,   // worker -> 0: int64 task, then the exception's text
+  kTask = 3,    // 0 -> worker: int64 task
+  kStop = 4,    // 0 -> worker: empty (all done) or the first error's text
+  kBcast = 5,   // 0 -> worker: uint64 length, then the bytes in chunks
+  kGather = 6,  // worker -> 0: a token
+};
+
+// Chunks stay below MPI's int count.
+constexpr size_t kChunk = size_t{1} << 30;
+
+void check(int rc, const char* what) {
+  if (rc != MPI_SUCCESS) {
+    char text[MPI_MAX_ERROR_STRING];
+    int len = 0;
+    MPI_Error_string(rc, text, &len);
+    throw std::runtime_error(std::string("MPI: ") + what + ": " + std::string(text, static_cast<size_t>(len)));
+  }
+}
+
+void send(const std::string& bytes, int dest, int tag) {
+  check(MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD), "send");
+}
+
+// Waits for a message without spinning a core: a waiting rank naps between probes, so ranks that
+// share a core with a working one (an oversubscribed job) leave it the CPU.
+MPI_Status wait_message(int source, int tag) {
+  MPI_Status st;
+  for (int idle = 0;; ++idle) {
+    int flag = 0;
+    check(MPI_Iprobe(source, tag, MPI_COMM_WORLD, &flag, &st), "probe");
+    if (flag) return st;
+    // The first probes come back at once (a reply is usually microseconds away), then 0.2 ms naps.
+    if (idle > 50) std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+}
+
+std::string receive(const MPI_Status& st) {
+  int count = 0;
+  check(MPI_Get_count(&st, MPI_BYTE, &count), "count");
+  std::string bytes(static_cast<size_t>(count), '\0');
+  check(MPI_Recv(bytes.data(), count, MPI_BYTE, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
+        "receive");
+  return bytes;
+}
+
+std::string with_index(int64_t k, const std::string& payload) {
+  std::string m(sizeof k, '\0');
+  std::memcpy(m.data(), &k, sizeof k);
+  return m + payload;
+}
+int64_t index_of(const std::string& m) {
+  int64_t k = -1;
+  if (m.size() >= sizeof k) std::memcpy(&k, m.data(), sizeof k);
+  return k;
+}
+
+class MpiFarm : public TaskFarm {
+ public:
+  explicit MpiFarm(const MpiSession& s) : rank_(s.rank()), size_(s.size()) {}
+  bool coordinator() const override { return rank_ == 0; }
+  int workers() const override { return size_ - 1; }
+  bool distributed() const override { return size_ > 1; }
+
+  void broadcast(std::string& bytes) override {
+    // Point to point from rank 0 rather than MPI_Bcast, so that waiting ranks nap (wait_message)
+    // instead of spinning in the collective while rank 0 works.
+    if (rank_ == 0) {
+      const uint64_t n = bytes.size();
+      for (int r = 1; r < size_; ++r) {
+        check(MPI_Send(&n, 1, MPI_UINT64_T, r, kBcast, MPI_COMM_WORLD), "send");
+        for (size_t off = 0; off < bytes.size(); off += kChunk)
+          check(MPI_Send(bytes.data() + off, static_cast<int>(std::min(kChunk, bytes.size() - off)), MPI_BYTE, r,
+                         kBcast, MPI_COMM_WORLD),
+                "send");
+      }
+      return;
+    }
+    wait_message(0, kBcast);
+    uint64_t n = 0;
+    check(MPI_Recv(&n, 1, MPI_UINT64_T, 0, kBcast, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "receive");
+    bytes.assign(n, '\0');
+    for (size_t off = 0; off < n; off += kChunk)
+      check(MPI_Recv(bytes.data() + off, static_cast<int>(std::min<size_t>(kChunk, n - off)), MPI_BYTE, 0, kBcast,
+                     MPI_COMM_WORLD, MPI_STATUS_IGNORE),
+            "receive");
+  }
+
+  std::vector<std::string> gather(const std::string& token) override {
+    if (rank_ != 0) {
+      send(token, 0, kGather);
+      return {};
+    }
+    std::vector<std::string> all{token};
+    for (int r = 1; r < size_; ++r) all.push_back(receive(wait_message(r, kGather)));
+    return all;
+  }
+
+  void run(size_t n, const Task& task, const Done& done, const Started& started, const Idle& idle) override {
+    if (rank_ == 0)
+      coordinate(n, done, started, idle);
+    else
+      work(task);
+  }
+
+ private:
+  void coordinate(size_t n, const Done& done, const Started& started, const Idle& idle) {
+    size_t next = 0;
+    int stopped = 0;
+    std::string error;
+    auto last_idle = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+    while (stopped < size_ - 1) {
+      MPI_Status st;
+      int flag = 0;
+      check(MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &st), "probe");
+      if (idle && std::chrono::steady_clock::now() - last_idle >= std::chrono::milliseconds(200)) {
+        idle();
+        last_idle = std::chrono::steady_clock::now();
+      }
+      if (!flag) {
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+        continue;
+      }
+      if (st.MPI_TAG != kResult && st.MPI_TAG != kError)
+        throw std::logic_error("MPI: unexpected message tag " + std::to_string(st.MPI_TAG) + " from rank " +
+                               std::to_string(st.MPI_SOURCE));
+      const std::string m = receive(st);
+      const int64_t k = index_of(m);
+      if (st.MPI_TAG == kError) {
+        if (error.empty()) error = m.substr(sizeof k);
+      } else if (k >= 0) {
+        // A result that arrives after an error still reaches `done`: a finished point is kept.
+        try {
+          done(static_cast<size_t>(k), m.substr(sizeof k));
+        } catch (const std::exception& e) {
+          if (error.empty()) error = e.what();
+        }
+      }
+      if (error.empty() && next < n) {
+        if (started) started(next);
+        const int64_t t = static_cast<int64_t>(next++);
+        check(MPI_Send(&t, 1, MPI_INT64_T, st.MPI_SOURCE, kTask, MPI_COMM_WORLD), "send");
+      } else {
+        send(error, st.MPI_SOURCE, kStop);
+        ++stopped;
+      }
+    }
+    if (!error.empty()) throw FarmError(error);
+  }
+
+  void work(const Task& task) {
+    send(with_index(-1, ""), 0, kResult);
+    for (;;) {
+      MPI_Status st = wait_message(0, MPI_ANY_TAG);
+      if (st.MPI_TAG == kStop) {
+        const std::string error = receive(st);
+        if (!error.empty()) throw FarmError(error);
+        return;
+      }
+      if (st.MPI_TAG != kTask) throw std::logic_error("MPI: unexpected message tag " + std::to_string(st.MPI_TAG));
+      int64_t k = -1;
+      check(MPI_Recv(&k, 1, MPI_INT64_T, 0, kTask, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "receive");
+      std::string result;
+      try {
+        result = task(static_cast<size_t>(k));
+      } catch (const std::exception& e) {
+        send(with_index(k, e.what()), 0, kError);
+        continue;
+      }
+      send(with_index(k, result), 0, kResult);
+    }
+  }
+
+  int rank_, size_;
+};
+
+}  // namespace
+
+MpiSession::MpiSession() {
+  int initialized = 0;
+  MPI_Initialized(&initialized);
+  if (!initialized) check(MPI_Init(nullptr, nullptr), "init");
+  // Errors come back as codes (turned into exceptions) instead of aborting the job.
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+}
+
+MpiSession::~MpiSession() {
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (!finalized) MPI_Finalize();
+}
+
+std::unique_ptr<TaskFarm> make_mpi_farm(const MpiSession& session) { return std::make_unique<MpiFarm>(session); }
+
+std::string mpi_library_version() {
+  char text[MPI_MAX_LIBRARY_VERSION_STRING];
+  int len = 0;
+  MPI_Get_library_version(text, &len);
+  std::string v(text, static_cast<size_t>(len));
+  const size_t cut = v.find_first_of(",\n");
+  return cut == std::string::npos ? v : v.substr(0, cut);
+}
+
+}  // namespace tippe

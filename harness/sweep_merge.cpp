@@ -1,0 +1,215 @@
+// `tippe sweep --merge`: the shard directories of one sweep combined into the directory a whole run would have made.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <tuple>
+
+#include "dir_lock.h"
+#include "provenance.h"
+#include "records.h"
+#include "sweep.h"
+
+namespace tippe {
+
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+struct ShardDir {
+  fs::path dir;
+  json meta;
+  int index = 0, count = 0;
+  std::vector<std::string> ids;  // the shard's points, in plan order
+  std::vector<SweepRecord> records;
+};
+
+[[noreturn]] void refuse(const std::string& why) { throw SweepInputError(why); }
+
+std::string where(const fs::path& dir) { return dir.string(); }
+
+std::string number_text(double v) {
+  std::ostringstream ss;
+  ss << v;
+  return ss.str();
+}
+
+ShardDir read_shard(const fs::path& dir) {
+  ShardDir s;
+  s.dir = dir;
+  const fs::path meta = dir / "sweep.json", records = dir / "records.jsonl";
+  std::error_code ec;
+  if (!fs::is_regular_file(meta, ec)) refuse(where(dir) + ": no sweep.json (not a sweep directory)");
+  try {
+    std::ifstream in(meta);
+    s.meta = json::parse(in);
+    s.meta.at("sweep_hash").get<std::string>();
+    s.meta.at("plan_hash").get<std::string>();
+    s.meta.at("points").get<size_t>();
+    const json& shard = s.meta.value("shard", json(nullptr));
+    if (shard.is_null())
+      refuse(meta.string() + ": shard: not a shard (it holds the whole sweep); merge takes the directories of "
+                             "`tippe sweep SWEEP --shard I/N`");
+    s.index = shard.at("index").get<int>();
+    s.count = shard.at("count").get<int>();
+    s.ids = shard.at("point_ids").get<std::vector<std::string>>();
+  } catch (const json::exception& e) {
+    refuse(meta.string() + ": not a sweep record (" + e.what() + ")");
+  }
+  RecordsFile f;
+  try {
+    f = read_records(records.string());
+  } catch (const std::runtime_error& e) {
+    refuse(e.what());
+  }
+  if (f.partial_bytes)
+    refuse(records.string() + ": ends in a partial line (" + std::to_string(f.partial_bytes) +
+           " bytes): the shard was cut short; run it again to finish it");
+  s.records = std::move(f.records);
+  return s;
+}
+
+std::string shard_name(const ShardDir& s) { return std::to_string(s.index) + "/" + std::to_string(s.count); }
+
+bool same_dir(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
+}
+
+}  // namespace
+
+MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std::string& out_dir, bool restart,
+                          bool plots) {
+  if (shard_dirs.empty()) refuse("--merge needs the shard directories");
+  if (out_dir.empty()) refuse("--merge needs --out DIR for the merged sweep");
+  const fs::path out = out_dir;
+
+  // Everything is read and checked before the output directory is touched.
+  std::vector<ShardDir> shards;
+  for (const std::string& d : shard_dirs) {
+    if (same_dir(d, out)) refuse(d + ": is the --out directory; merge into a new directory");
+    shards.push_back(read_shard(d));
+  }
+  const ShardDir& first = shards.front();
+  const std::string sweep_hash = first.meta["sweep_hash"], plan_hash = first.meta["plan_hash"];
+  std::map<int, const ShardDir*> by_index;
+  for (const ShardDir& s : shards) {
+    const std::string h = s.meta["sweep_hash"], ph = s.meta["plan_hash"];
+    if (h != sweep_hash)
+      refuse(where(s.dir) + ": sweep_hash: a shard of another sweep file (" + h + ", " + where(first.dir) +
+             " has " + sweep_hash + ")");
+    if (ph != plan_hash)
+      refuse(where(s.dir) + ": plan_hash: a shard of the same sweep file over other scene physics (" + ph + ", " +
+             where(first.dir) + " has " + plan_hash + ")");
+    if (s.count != first.count)
+      refuse(where(s.dir) + ": shard: " + shard_name(s) + " is of another split than " + where(first.dir) + "'s " +
+             shard_name(first));
+    auto [it, fresh] = by_index.emplace(s.index, &s);
+    if (!fresh) refuse(where(s.dir) + ": shard " + shard_name(s) + " given twice (also " + where(it->second->dir) + ")");
+  }
+  std::string missing;
+  for (int i = 0; i < first.count; ++i)
+    if (!by_index.count(i)) missing += (missing.empty() ? "" : ", ") + std::to_string(i) + "/" + std::to_string(first.count);
+  if (!missing.empty()) refuse("shard(s) " + missing + " missing: every shard of the split must be merged");
+
+  // Each shard holds exactly its own points, each once: nothing lost, nothing twice.
+  std::set<std::string> all_ids;
+  std::vector<const SweepRecord*> merged;
+  MergeOutcome outcome;
+  std::set<std::string> commits;
+  for (const ShardDir& s : shards) {
+    const std::set<std::string> own(s.ids.begin(), s.ids.end());
+    std::set<std::string> seen;
+    for (const SweepRecord& r : s.records) {
+      if (!own.count(r.point_id))
+        refuse(where(s.dir / "records.jsonl") + ": point " + r.point_id + " (" + r.scene + ", " + r.setup + ", " +
+               r.ladder_key + " = " + number_text(r.ladder_value) + ") is not of shard " + shard_name(s));
+      if (!seen.insert(r.point_id).second) continue;  // a duplicate line: the first counts, as in the report
+      merged.push_back(&r);
+      commits.insert(r.git_commit);
+    }
+    if (seen.size() != own.size())
+      refuse(where(s.dir) + ": " + std::to_string(own.size() - seen.size()) + " of " + std::to_string(own.size()) +
+             " points of shard " + shard_name(s) + " unfinished; run the shard again to finish it");
+    for (const std::string& id : own)
+      if (!all_ids.insert(id).second) refuse(where(s.dir) + ": point " + id + " is also in another shard");
+  }
+  if (all_ids.size() != first.meta["points"].get<size_t>())
+    refuse("the shards hold " + std::to_string(all_ids.size()) + " points, the sweep has " +
+           first.meta["points"].dump());
+  if (commits.size() > 1) {
+    std::string list;
+    for (const std::string& c : commits) list += (list.empty() ? "" : ", ") + c;
+    outcome.warnings.push_back("the shards' records come from more than one build (" + list + ")");
+  }
+  std::stable_sort(merged.begin(), merged.end(), [](const SweepRecord* a, const SweepRecord* b) {
+    return std::tie(a->scene_index, a->setup_index, a->ladder_index) <
+           std::tie(b->scene_index, b->setup_index, b->ladder_index);
+  });
+
+  // The output directory: new, or an earlier merge of the same sweep, or begun again (--restart).
+  const fs::path meta_file = out / "sweep.json", records_file = out / "records.jsonl";
+  std::error_code ec;
+  if (fs::exists(meta_file, ec)) {
+    json old;
+    try {
+      std::ifstream in(meta_file);
+      old = json::parse(in);
+    } catch (const json::exception&) {
+    }
+    const bool earlier_merge = old.is_object() && old.value("sweep_hash", "") == sweep_hash &&
+                               old.value("plan_hash", "") == plan_hash && old.contains("merged_from");
+    if (!earlier_merge && !restart)
+      refuse(meta_file.string() + ": " + out.string() +
+             " holds another sweep or a run of its own; give another --out, or --restart to begin it again");
+  } else if (fs::exists(records_file, ec) && !restart) {
+    refuse(records_file.string() + ": records without " + meta_file.string() +
+           "; give another --out, or --restart to begin it again");
+  }
+  fs::create_directories(out, ec);
+  if (ec) refuse(out.string() + ": cannot create the output directory: " + ec.message());
+  DirLock lock(out);
+  if (restart && fs::exists(records_file, ec)) fs::rename(records_file, out / "records.jsonl.old");
+
+  json meta = first.meta;
+  meta["shard"] = nullptr;
+  json from = json::array();
+  for (const auto& [i, s] : by_index)
+    from.push_back({{"dir", s->dir.string()}, {"index", i}, {"provenance", s->meta.value("provenance", json())}});
+  meta["merged_from"] = from;
+  const Provenance p = current_provenance();
+  meta["provenance"] = {{"git_commit", p.git_commit}, {"compiler", p.compiler}, {"cxx_flags", p.cxx_flags},
+                        {"date", p.date},             {"hostname", p.hostname}};
+  write_file_atomic(meta_file.string(), meta.dump(2) + "\n");
+
+  // The references, so that a later `tippe sweep SWEEP --out DIR` finds them cached.
+  for (const auto& [i, s] : by_index) {
+    const fs::path refs = s->dir / "reference";
+    if (!fs::is_directory(refs, ec)) continue;
+    for (const auto& entry : fs::directory_iterator(refs, ec)) {
+      const fs::path src = entry.path(), dst = out / "reference" / src.filename();
+      if (!entry.is_directory() || fs::exists(dst / "summary.json", ec) || !fs::exists(src / "summary.json", ec))
+        continue;
+      fs::create_directories(dst);
+      for (const char* name : {"trajectory.csv", "summary.json"})  // the summary last, as in the cache
+        write_file_atomic((dst / name).string(), read_file_text((src / name).string()));
+    }
+  }
+
+  std::string text;
+  std::vector<SweepRecord> records;
+  for (const SweepRecord* r : merged) {
+    text += to_jsonl(*r);
+    records.push_back(*r);
+  }
+  write_file_atomic(records_file.string(), text);
+  write_sweep_report(out.string(), records, plots);
+  outcome.shards = shards.size();
+  outcome.points = records.size();
+  return outcome;
+}
+
+}  // namespace tippe
