@@ -1,4 +1,4 @@
-// `tippe sweep`: work-precision sweeps over engine settings into a resumable directory, and --report to rebuild one.
+// `tippe sweep`: work-precision sweeps into a resumable directory, on threads or MPI ranks, in shards (--shard, --merge), and --report to rebuild one.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -29,9 +29,9 @@ struct SweepCliOptions {
 };
 
 int report_only(const SweepCliOptions& o) {
-  if (!o.sweep.empty() || !o.out.empty() || o.restart)
+  if (!o.sweep.empty() || !o.out.empty() || o.restart || !o.shard.empty())
     throw UsageError(
-        "--report DIR rebuilds a report from DIR/records.jsonl; it takes no sweep file, --out or --restart");
+        "--report DIR rebuilds a report from DIR/records.jsonl; it takes no sweep file, --out, --restart or --shard");
   const fs::path records = fs::path(o.report_dir) / "records.jsonl";
   std::error_code ec;
   if (!fs::is_regular_file(records, ec)) throw UsageError(records.string() + ": cannot read (not a sweep directory?)");

@@ -3,7 +3,9 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
@@ -21,8 +23,7 @@ enum Tag : int {
   kError = 2,   // worker -> 0: int64 task, then the exception's text
   kTask = 3,    // 0 -> worker: int64 task
   kStop = 4,    // 0 -> worker: empty (all done) or the first error's text
-  kBcast = 5,   // 0 -> worker: uint64 length, then the bytes in chunks
-  kGather = 6,  // worker -> 0: a token
+  kGather = 5,  // worker -> 0: a token
 };
 
 // Chunks stay below MPI's int count.
@@ -41,16 +42,32 @@ void send(const std::string& bytes, int dest, int tag) {
   check(MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD), "send");
 }
 
-// Waits for a message without spinning a core: a waiting rank naps between probes, so ranks that
-// share a core with a working one (an oversubscribed job) leave it the CPU.
+// Waits for a message without holding a core: a reply to a worker's request comes within
+// microseconds, so the first millisecond is spent probing; after that the rank naps between
+// probes (a worker waiting while rank 0 prepares, or a rank sharing its core with a working one
+// in an oversubscribed job, leaves the CPU to the others).
 MPI_Status wait_message(int source, int tag) {
   MPI_Status st;
-  for (int idle = 0;; ++idle) {
+  const auto spin_until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1);
+  for (;;) {
     int flag = 0;
     check(MPI_Iprobe(source, tag, MPI_COMM_WORLD, &flag, &st), "probe");
     if (flag) return st;
-    // The first probes come back at once (a reply is usually microseconds away), then 0.2 ms naps.
-    if (idle > 50) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    if (std::chrono::steady_clock::now() > spin_until) std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+}
+
+// Starts a non-blocking operation and waits for it as wait_message does.
+template <class Start>
+void wait_request(Start start) {
+  MPI_Request request;
+  check(start(&request), "start");
+  const auto spin_until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1);
+  for (;;) {
+    int flag = 0;
+    check(MPI_Test(&request, &flag, MPI_STATUS_IGNORE), "test");
+    if (flag) return;
+    if (std::chrono::steady_clock::now() > spin_until) std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
 }
 
@@ -82,27 +99,17 @@ class MpiFarm : public TaskFarm {
   bool distributed() const override { return size_ > 1; }
 
   void broadcast(std::string& bytes) override {
-    // Point to point from rank 0 rather than MPI_Bcast, so that waiting ranks nap (wait_message)
-    // instead of spinning in the collective while rank 0 works.
-    if (rank_ == 0) {
-      const uint64_t n = bytes.size();
-      for (int r = 1; r < size_; ++r) {
-        check(MPI_Send(&n, 1, MPI_UINT64_T, r, kBcast, MPI_COMM_WORLD), "send");
-        for (size_t off = 0; off < bytes.size(); off += kChunk)
-          check(MPI_Send(bytes.data() + off, static_cast<int>(std::min(kChunk, bytes.size() - off)), MPI_BYTE, r,
-                         kBcast, MPI_COMM_WORLD),
-                "send");
-      }
-      return;
+    // A non-blocking collective (a tree: log2(ranks) steps, not one send per rank from rank 0),
+    // waited for with naps, so that ranks waiting while rank 0 works do not spin.
+    uint64_t n = bytes.size();
+    wait_request([&](MPI_Request* r) { return MPI_Ibcast(&n, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD, r); });
+    if (rank_ != 0) bytes.assign(n, '\0');
+    for (size_t off = 0; off < n; off += kChunk) {
+      const int count = static_cast<int>(std::min<size_t>(kChunk, n - off));
+      wait_request([&](MPI_Request* r) {
+        return MPI_Ibcast(bytes.data() + off, count, MPI_BYTE, 0, MPI_COMM_WORLD, r);
+      });
     }
-    wait_message(0, kBcast);
-    uint64_t n = 0;
-    check(MPI_Recv(&n, 1, MPI_UINT64_T, 0, kBcast, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "receive");
-    bytes.assign(n, '\0');
-    for (size_t off = 0; off < n; off += kChunk)
-      check(MPI_Recv(bytes.data() + off, static_cast<int>(std::min<size_t>(kChunk, n - off)), MPI_BYTE, 0, kBcast,
-                     MPI_COMM_WORLD, MPI_STATUS_IGNORE),
-            "receive");
   }
 
   std::vector<std::string> gather(const std::string& token) override {
@@ -124,9 +131,13 @@ class MpiFarm : public TaskFarm {
 
  private:
   void coordinate(size_t n, const Done& done, const Started& started, const Idle& idle) {
-    size_t next = 0;
+    size_t next = 0, in_flight = 0;
     int stopped = 0;
     std::string error;
+    // Workers with nothing left to do. They are stopped together once every task handed out has
+    // come back and reached `done`, so that all of them learn the same outcome (an error in the
+    // last `done` included) and leave run() alike.
+    std::vector<int> waiting;
     auto last_idle = std::chrono::steady_clock::now() - std::chrono::seconds(1);
     while (stopped < size_ - 1) {
       MPI_Status st;
@@ -137,17 +148,29 @@ class MpiFarm : public TaskFarm {
         last_idle = std::chrono::steady_clock::now();
       }
       if (!flag) {
-        std::this_thread::sleep_for(std::chrono::microseconds(100));
+        std::this_thread::sleep_for(std::chrono::microseconds(50));
         continue;
       }
-      if (st.MPI_TAG != kResult && st.MPI_TAG != kError)
-        throw std::logic_error("MPI: unexpected message tag " + std::to_string(st.MPI_TAG) + " from rank " +
-                               std::to_string(st.MPI_SOURCE));
+      if (st.MPI_TAG != kResult && st.MPI_TAG != kError) {
+        // Only a bug gets here; the job cannot go on in step, so it ends rather than hangs.
+        std::fprintf(stderr, "tippe: error: internal: MPI message tag %d from rank %d\n", st.MPI_TAG, st.MPI_SOURCE);
+        MPI_Abort(MPI_COMM_WORLD, 1);
+      }
       const std::string m = receive(st);
       const int64_t k = index_of(m);
-      if (st.MPI_TAG == kError) {
-        if (error.empty()) error = m.substr(sizeof k);
-      } else if (k >= 0) {
+      if (k >= 0) --in_flight;
+      if (st.MPI_TAG == kError && error.empty()) error = m.substr(sizeof k);
+      // The worker gets its next task before its result is handled, so that appending the
+      // record (an fsync) overlaps with the next run instead of keeping the worker waiting.
+      if (error.empty() && next < n) {
+        if (started) started(next);
+        const int64_t t = static_cast<int64_t>(next++);
+        ++in_flight;
+        check(MPI_Send(&t, 1, MPI_INT64_T, st.MPI_SOURCE, kTask, MPI_COMM_WORLD), "send");
+      } else {
+        waiting.push_back(st.MPI_SOURCE);
+      }
+      if (st.MPI_TAG == kResult && k >= 0) {
         // A result that arrives after an error still reaches `done`: a finished point is kept.
         try {
           done(static_cast<size_t>(k), m.substr(sizeof k));
@@ -155,13 +178,10 @@ class MpiFarm : public TaskFarm {
           if (error.empty()) error = e.what();
         }
       }
-      if (error.empty() && next < n) {
-        if (started) started(next);
-        const int64_t t = static_cast<int64_t>(next++);
-        check(MPI_Send(&t, 1, MPI_INT64_T, st.MPI_SOURCE, kTask, MPI_COMM_WORLD), "send");
-      } else {
-        send(error, st.MPI_SOURCE, kStop);
-        ++stopped;
+      if (in_flight == 0 && (next == n || !error.empty())) {
+        for (int w : waiting) send(error, w, kStop);
+        stopped += static_cast<int>(waiting.size());
+        waiting.clear();
       }
     }
     if (!error.empty()) throw FarmError(error);

@@ -1241,18 +1241,24 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
 
   // 3. Every rank gets the same texts of every reference it needs, and reads them the way the cache is read.
   if (farm.distributed()) {
-    std::string bytes;
-    if (farm.coordinator())
-      for (size_t i : prep.needed) {
-        const fs::path dir = out / "reference" / plan.physics_hashes[i];
-        bytes += pack_texts(read_file_text((dir / "summary.json").string()),
-                             read_file_text((dir / "trajectory.csv").string()));
+    std::string bytes = "ok\n";
+    if (farm.coordinator()) {
+      try {
+        for (size_t i : prep.needed) {
+          const fs::path dir = out / "reference" / plan.physics_hashes[i];
+          bytes += pack_texts(read_file_text((dir / "summary.json").string()),
+                              read_file_text((dir / "trajectory.csv").string()));
+        }
+      } catch (const std::exception& e) {
+        bytes = std::string("error\n") + e.what();
       }
+    }
     farm.broadcast(bytes);
+    if (bytes.compare(0, 3, "ok\n") != 0) throw std::runtime_error(bytes.substr(bytes.find('\n') + 1));
     std::string error;
     if (!farm.coordinator()) {
       try {
-        size_t pos = 0;
+        size_t pos = 3;
         for (size_t i : prep.needed) {
           const auto [summary, csv] = unpack_texts(bytes, pos);
           const std::string why = reference_from_text(summary, csv, plan.scenes[i], plan.physics_hashes[i],

@@ -181,9 +181,9 @@ struct SweepOutcome {
   double wall_seconds = 0;
 };
 
-// Runs every point of `plan` not yet in OUT/records.jsonl, on `jobs` threads, appending one
-// fsynced line per finished point; then writes the report. Layout of OUT: sweep.json (the sweep
-// file, its hash and the plan hash), records.jsonl, reference/<physics_hash>/{summary.json,
+// Runs every point of `plan` (or of options.shard's share) not yet in OUT/records.jsonl, on
+// `jobs` threads, appending one fsynced line per finished point; then writes the report. Layout
+// of OUT: sweep.json (the sweep file, its hash, the plan hash and the shard), records.jsonl, reference/<physics_hash>/{summary.json,
 // trajectory.csv}, report.md, index.html, *.svg. Throws SweepInputError before anything is
 // written; an engine that diverges or throws is a point with that status, not an error.
 SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& options);

@@ -14,7 +14,7 @@ command -v "$cxx" >/dev/null || { echo "fuzz: $cxx not found (install clang and 
 # The same configuration as scripts/sanitize.sh, so that after it only the targets are built.
 cmake -S . -B "$build" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DTIPPE_SANITIZE=address,undefined \
-  -DTIPPE_FUZZ=ON -DTIPPE_BENCHMARKS=OFF >/dev/null
+  -DTIPPE_FUZZ=ON -DTIPPE_BENCHMARKS=OFF -DTIPPE_MPI=OFF >/dev/null
 list="$build/fuzz/fuzz_targets.txt"
 mapfile -t lines < <(grep -v '^[[:space:]]*$' "$list")
 targets=()

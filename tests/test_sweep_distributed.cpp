@@ -60,29 +60,24 @@ int wait_exit(pid_t pid) {
 
 int run(const std::vector<std::string>& argv, const fs::path& log) { return wait_exit(spawn(argv, log)); }
 
+// wait_exit, but a child still running after `seconds` (a hung job) is killed and reported as -1.
+int wait_exit_within(pid_t pid, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  int status = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    const pid_t r = ::waitpid(pid, &status, WNOHANG);
+    if (r == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(pid, SIGTERM);
+  wait_exit(pid);
+  return -1;
+}
+
 std::vector<std::string> tippe_sweep(std::vector<std::string> args) {
   args.insert(args.begin(), {kBinary, "sweep"});
   args.push_back("--no-plots");
   return args;
-}
-
-// Where mpirun is; "" when not on PATH.
-std::string mpirun_path() {
-  const char* path = std::getenv("PATH");
-  std::stringstream ss(path ? path : "");
-  for (std::string dir; std::getline(ss, dir, ':');)
-    if (!dir.empty() && ::access((fs::path(dir) / "mpirun").c_str(), X_OK) == 0) return (fs::path(dir) / "mpirun").string();
-  return "";
-}
-
-// mpirun -np N [--oversubscribe] tippe sweep ARGS. Open MPI refuses root without its two
-// allow-run-as-root variables (CI runs as root), and more ranks than cores without --oversubscribe.
-std::vector<std::string> mpirun_sweep(int np, std::vector<std::string> args) {
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-  std::vector<std::string> argv = {mpirun_path(), "--oversubscribe", "-np", std::to_string(np)};
-  for (const std::string& a : tippe_sweep(std::move(args))) argv.push_back(a);
-  return argv;
 }
 
 // ---- records ----------------------------------------------------------------------------------
@@ -349,9 +344,52 @@ TEST(SweepShards, AShardDirectoryTakesOnlyItsOwnShard) {
   EXPECT_FALSE(fs::exists(dir.path() / "x"));
 }
 
+// A sweep whose second scene's reference fails on its first step: the stiff scene on an explicit
+// method (Bulirsch-Stoer at k = 1e4).
+std::string failing_reference_sweep(const TempDir& dir) {
+  std::string scene = slurp(kSource + "/harness/scenes/extremes/k_high.toml");
+  const std::string from = "method = \"rosenbrock4\"";
+  scene.replace(scene.find(from), from.size(), "method = \"bulirsch_stoer\"");
+  dir.write("stiff_explicit.toml", scene);
+  return dir.write("fails.toml", "description = \"a reference that fails\"\nscenes = [\"" + kSource +
+                                     "/harness/scenes/toy.toml\", \"stiff_explicit.toml\"]\n"
+                                     "[[setup]]\nname = \"ode\"\nengine = \"ode\"\n"
+                                     "ladder.key = \"engines.ode.timestep\"\nladder.values = [1e-3, 2e-3]\n");
+}
+
+TEST(SweepShards, AFailingReferenceStopsALocalSweepWithItsMessage) {
+  TempDir dir("tippe-local-fail");
+  const std::string sweep = failing_reference_sweep(dir);
+  const fs::path log = dir.path() / "log";
+  EXPECT_EQ(wait_exit_within(spawn(tippe_sweep({sweep, "--out", (dir.path() / "out").string(), "--jobs", "2"}), log), 120),
+            1)
+      << slurp(log);
+  EXPECT_NE(slurp(log).find("reference run of"), std::string::npos) << slurp(log);
+  EXPECT_TRUE(lines_of(dir.path() / "out" / "records.jsonl").empty());
+}
+
 // ---- MPI --------------------------------------------------------------------------------------
 
 #ifdef TIPPE_HAVE_MPI
+
+// Where mpirun is; "" when not on PATH.
+std::string mpirun_path() {
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "");
+  for (std::string dir; std::getline(ss, dir, ':');)
+    if (!dir.empty() && ::access((fs::path(dir) / "mpirun").c_str(), X_OK) == 0) return (fs::path(dir) / "mpirun").string();
+  return "";
+}
+
+// mpirun -np N [--oversubscribe] tippe sweep ARGS. Open MPI refuses root without its two
+// allow-run-as-root variables (CI runs as root), and more ranks than cores without --oversubscribe.
+std::vector<std::string> mpirun_sweep(int np, std::vector<std::string> args) {
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+  std::vector<std::string> argv = {mpirun_path(), "--oversubscribe", "-np", std::to_string(np)};
+  for (const std::string& a : tippe_sweep(std::move(args))) argv.push_back(a);
+  return argv;
+}
 
 // The build found MPI, so mpirun must be there too (openmpi-bin): its absence is a failure.
 #define REQUIRE_MPIRUN() ASSERT_FALSE(mpirun_path().empty()) << "MPI was found at build time but mpirun is not on PATH"
@@ -477,6 +515,23 @@ TEST(SweepMpi, BadInputStopsEveryRankWithTheMessageOnce) {
   EXPECT_EQ(run(mpirun_sweep(2, {kSmoke, "--out", other.string()}), log), 2);
   EXPECT_NE(slurp(log).find("was started with another sweep file"), std::string::npos) << slurp(log);
   EXPECT_FALSE(fs::exists(other / "records.jsonl"));
+}
+
+TEST(SweepMpi, AReferenceFailingOnAWorkerStopsEveryRankWithItsMessage) {
+  REQUIRE_MPIRUN();
+  TempDir dir("tippe-mpi-fail");
+  const std::string sweep = failing_reference_sweep(dir);
+  const fs::path log = dir.path() / "log";
+  for (int np : {2, 3}) {
+    const int rc = wait_exit_within(spawn(mpirun_sweep(np, {sweep, "--out", (dir.path() / "out").string()}), log), 120);
+    ASSERT_NE(rc, -1) << "the job hung:\n" << slurp(log);
+    EXPECT_EQ(rc, 1) << slurp(log);
+    const std::string text = slurp(log);
+    EXPECT_NE(text.find("reference run of"), std::string::npos) << text;
+    EXPECT_EQ(text.find("tippe: error: "), text.rfind("tippe: error: ")) << "printed more than once:\n" << text;
+    // No point ran without its reference.
+    EXPECT_TRUE(lines_of(dir.path() / "out" / "records.jsonl").empty());
+  }
 }
 
 TEST(SweepMpi, OneRankRunsAsALocalSweep) {
