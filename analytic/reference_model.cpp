@@ -372,13 +372,20 @@ struct ReferenceModel::Impl {
         g_chk[k] = g_all(yk);
       }
     };
-    sample(std::clamp(static_cast<int>(std::ceil(periods * 8.0)), 2, 1024));
+    // Checks per step, 2..1024. A step whose end is not finite (a failing explicit method on a
+    // stiff scene) gets the fewest: its NaN must not reach the int conversion (undefined), and
+    // the step fails on its own further on.
+    auto checks = [&](double per_period) {
+      const double n = std::ceil(periods * per_period);
+      return std::isfinite(n) ? static_cast<int>(std::clamp(n, 2.0, 1024.0)) : 2;
+    };
+    sample(checks(8.0));
     const double load = dyn.body().M * dyn.body().g;
     bool near_lift = false;
     for (size_t i = 0; i < fns.size(); ++i)
       if (fns[i].kind == EvKind::NormalForce)
         for (const auto& gk : g_chk) near_lift = near_lift || gk[i] < 0.3 * load;
-    if (near_lift) sample(std::clamp(static_cast<int>(std::ceil(periods * 64.0)), 2, 1024));
+    if (near_lift) sample(checks(64.0));
     const int n_checks = static_cast<int>(t_chk.size()) - 1;
     const std::vector<double>& g1 = g_chk[n_checks];
     double best_t = t1 + 1.0;

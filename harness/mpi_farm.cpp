@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -39,36 +40,43 @@ void check(int rc, const char* what) {
 }
 
 void send(const std::string& bytes, int dest, int tag) {
+  // One message per record or reference; only the broadcast needs chunks.
+  if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max()))
+    throw std::runtime_error("MPI: a message of " + std::to_string(bytes.size()) + " bytes is over MPI's 2 GiB");
   check(MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD), "send");
 }
 
-// Waits for a message without holding a core: a reply to a worker's request comes within
-// microseconds, so the first millisecond is spent probing; after that the rank naps between
-// probes (a worker waiting while rank 0 prepares, or a rank sharing its core with a working one
-// in an oversubscribed job, leaves the CPU to the others).
-MPI_Status wait_message(int source, int tag) {
-  MPI_Status st;
+// Polls `ready` without holding a core: a reply to a worker's request comes within microseconds,
+// so the first millisecond is spent probing; after that the rank naps between probes (a worker
+// waiting while rank 0 prepares, or a rank sharing its core with a working one in an
+// oversubscribed job, leaves the CPU to the others).
+template <class Ready>
+void wait_until(Ready ready) {
   const auto spin_until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1);
-  for (;;) {
-    int flag = 0;
-    check(MPI_Iprobe(source, tag, MPI_COMM_WORLD, &flag, &st), "probe");
-    if (flag) return st;
+  while (!ready())
     if (std::chrono::steady_clock::now() > spin_until) std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
 }
 
-// Starts a non-blocking operation and waits for it as wait_message does.
+MPI_Status wait_message(int source, int tag) {
+  MPI_Status st;
+  wait_until([&] {
+    int flag = 0;
+    check(MPI_Iprobe(source, tag, MPI_COMM_WORLD, &flag, &st), "probe");
+    return flag != 0;
+  });
+  return st;
+}
+
+// Starts a non-blocking operation and waits for it to complete.
 template <class Start>
 void wait_request(Start start) {
   MPI_Request request;
   check(start(&request), "start");
-  const auto spin_until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1);
-  for (;;) {
+  wait_until([&] {
     int flag = 0;
     check(MPI_Test(&request, &flag, MPI_STATUS_IGNORE), "test");
-    if (flag) return;
-    if (std::chrono::steady_clock::now() > spin_until) std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
+    return flag != 0;
+  });
 }
 
 std::string receive(const MPI_Status& st) {
