@@ -216,6 +216,18 @@ TEST(SweepShards, ShardsPartitionThePlanAndBalanceItsWeight) {
   EXPECT_EQ(total, plan.points.size());
 }
 
+// Records from ranks or merged shards arrive in another order than a local run's: the report must
+// not depend on it.
+TEST(SweepShards, TheReportDoesNotDependOnTheOrderOfTheRecords) {
+  std::vector<SweepRecord> records = read_records((local_smoke() / "records.jsonl").string()).records;
+  ASSERT_EQ(records.size(), 20u);
+  const std::string expected = render_sweep_markdown(records);
+  std::reverse(records.begin(), records.end());
+  EXPECT_EQ(render_sweep_markdown(records), expected);
+  std::rotate(records.begin(), records.begin() + 7, records.end());
+  EXPECT_EQ(render_sweep_markdown(records), expected);
+}
+
 TEST(SweepShards, ParseShardTakesIOverNAndNamesWhatIsWrong) {
   EXPECT_EQ(parse_shard("0/1").index, 0);
   EXPECT_EQ(parse_shard("2/3").count, 3);
