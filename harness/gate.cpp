@@ -17,6 +17,7 @@
 
 #include <toml++/toml.h>
 
+#include "records.h"
 #include "scene_io.h"
 #include "toml_text.h"
 
@@ -284,16 +285,15 @@ const GateMetric* find_gate_metric(const std::string& name) {
 
 GateFile load_gate_file(const std::string& path) {
   GateReader reader(path);
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw SceneError(path + ": cannot read: is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path + ": cannot read: " + std::strerror(errno));
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (in.bad()) throw SceneError(path + ": cannot read: " + std::strerror(errno));
+  std::string text;
+  try {
+    text = read_file_text(path);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
+  }
   toml::table root;
   try {
-    root = toml::parse(bytes.str(), path);
+    root = toml::parse(text, path);
   } catch (const toml::parse_error& e) {
     throw SceneError(path + ":" + std::to_string(e.source().begin.line) + ":" +
                      std::to_string(e.source().begin.column) + ": " + std::string(e.description()));

@@ -315,6 +315,8 @@ void write_file_atomic(const std::string& path, const std::string& text) {
 }
 
 std::string read_file_text(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": cannot read: is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot read: " + errno_text());
   std::ostringstream ss;

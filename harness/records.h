@@ -106,7 +106,8 @@ long long json_integer(const nlohmann::json& j, const char* key);
 // Writes `text` to `path.tmp.PID`, fsyncs it and renames it over `path`, so readers see the old
 // file or the new one, never a part. Throws std::runtime_error (temporary removed) on failure.
 void write_file_atomic(const std::string& path, const std::string& text);
-// A whole file's bytes; throws std::runtime_error "PATH: cannot read: reason".
+// A whole file's bytes; throws std::runtime_error "PATH: cannot read: reason" (a directory
+// included). The file readers turn it into their own error type.
 std::string read_file_text(const std::string& path);
 
 // The trajectory columns, in file order.

@@ -19,6 +19,7 @@
 
 #include "adapters.h"
 #include "mass_properties.h"
+#include "records.h"
 
 namespace tippe {
 
@@ -477,14 +478,13 @@ class Interpreter {
 }  // namespace
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw SceneError(path + ": cannot read: is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path + ": cannot read: " + std::strerror(errno));
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (in.bad()) throw SceneError(path + ": cannot read: " + std::strerror(errno));
-  return parse_scene_text(bytes.str(), path, overrides);
+  std::string text;
+  try {
+    text = read_file_text(path);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
+  }
+  return parse_scene_text(text, path, overrides);
 }
 
 Scene parse_scene_text(const std::string& text, const std::string& file_label,

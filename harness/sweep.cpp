@@ -70,16 +70,6 @@ bool is_name(const std::string& n) {
 
 std::string idx(const std::string& key, size_t i) { return key + "[" + std::to_string(i) + "]"; }
 
-std::string read_bytes(const std::string& path, const std::function<void(const std::string&)>& fail) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) fail("is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(std::strerror(errno));
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (in.bad()) fail(std::strerror(errno));
-  return bytes.str();
-}
 
 // Checks one sweep file; every message names the file and the dotted key.
 class SweepReader {
@@ -333,8 +323,12 @@ std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& se
 
 SweepPlan load_sweep(const std::string& path) {
   SweepReader reader(path);
-  const std::string text =
-      read_bytes(path, [&](const std::string& why) { throw SceneError(path + ": cannot read: " + why); });
+  std::string text;
+  try {
+    text = read_file_text(path);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
+  }
   toml::table root;
   try {
     root = toml::parse(text, path);
@@ -569,15 +563,9 @@ size_t complete_lines_length(const std::string& text) {
 
 RecordsFile read_records(const std::string& path) {
   RecordsFile f;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) return f;
-    throw std::runtime_error(path + ": cannot read: " + std::strerror(errno));
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return f;
+  const std::string text = read_file_text(path);
   f.complete_bytes = complete_lines_length(text);
   f.partial_bytes = text.size() - f.complete_bytes;
   size_t pos = 0, line = 0;
