@@ -1,7 +1,5 @@
 // Tables of malformed inputs: scene files (and odd but valid ones), and out-of-range values across scene, sweep and gate files, each naming the file, key and value; and malformed record counts.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -17,6 +15,7 @@
 #include "scene_io.h"
 #include "sweep.h"
 #include "test_files.h"
+#include "test_process.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
@@ -397,27 +396,11 @@ struct Outcome {
 
 // `tippe ARGS` with stdout to /dev/null and stderr captured (no shell: arguments pass as they are).
 Outcome run_tippe(const std::vector<std::string>& args, const fs::path& err_file) {
-  const std::string binary = std::string(TIPPE_BINARY_DIR) + "/tippe";
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int err = ::open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int null = ::open("/dev/null", O_WRONLY);
-    ::dup2(err, 2);
-    ::dup2(null, 1);
-    std::vector<char*> argv = {const_cast<char*>(binary.c_str())};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(binary.c_str(), argv.data());
-    ::_exit(127);
-  }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
+  std::vector<std::string> argv = {std::string(TIPPE_BINARY_DIR) + "/tippe"};
+  argv.insert(argv.end(), args.begin(), args.end());
   Outcome o;
-  if (WIFEXITED(status)) o.code = WEXITSTATUS(status);
-  std::ifstream in(err_file, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  o.err = ss.str();
+  o.code = wait_process(spawn_process(argv, "/dev/null", err_file)).code;
+  o.err = slurp(err_file);
   return o;
 }
 

@@ -1,8 +1,6 @@
 // Tests of `tippe sweep`: records, the analysis on synthetic data, sweep-file checks, and a killed sweep resumed.
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -18,6 +16,8 @@
 #include "scene_io.h"
 #include "sweep.h"
 #include "test_files.h"
+#include "test_process.h"
+#include "test_records.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
@@ -413,40 +413,15 @@ TEST(SweepFiles, InvalidFilesNameFileAndKey) {
 
 namespace {
 
-struct Exit {
-  int code = -1;  // exit status, or -1 when killed
-  int signal = 0;
-};
-
 // Starts `tippe ARGS` with stderr to err_file, stdout to /dev/null.
 pid_t start_tippe(const std::vector<std::string>& args, const fs::path& err_file) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int err = ::open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int null = ::open("/dev/null", O_WRONLY);
-    ::dup2(err, 2);
-    ::dup2(null, 1);
-    std::vector<char*> argv;
-    argv.push_back(const_cast<char*>(kBinary.c_str()));
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(kBinary.c_str(), argv.data());
-    ::_exit(127);
-  }
-  return pid;
+  std::vector<std::string> argv = {kBinary};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return spawn_process(argv, "/dev/null", err_file);
 }
 
-Exit wait_tippe(pid_t pid) {
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  Exit e;
-  if (WIFEXITED(status)) e.code = WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) e.signal = WTERMSIG(status);
-  return e;
-}
-
-Exit run_tippe(const std::vector<std::string>& args, const fs::path& err_file) {
-  return wait_tippe(start_tippe(args, err_file));
+ChildExit run_tippe(const std::vector<std::string>& args, const fs::path& err_file) {
+  return wait_process(start_tippe(args, err_file));
 }
 
 size_t count_lines(const fs::path& p) {
@@ -454,22 +429,10 @@ size_t count_lines(const fs::path& p) {
   return static_cast<size_t>(std::count(t.begin(), t.end(), '\n'));
 }
 
-// A record without what depends on the machine's load: timings and the cost ratio.
-json without_timings(const SweepRecord& r) {
-  json j = to_json(r);
-  j.erase("work");
-  for (const char* k : {"cpu_seconds", "wall_seconds", "real_time_factor", "cost_ratio"}) j["metrics"].erase(k);
-  if (j["reference"].is_object()) j["reference"].erase("cpu_seconds");
-  j["steps"] = r.steps;
-  j["rhs_evaluations"] = r.rhs_evaluations;
-  j["solver_iterations"] = r.solver_iterations;
-  return j;
-}
-
 std::map<std::string, json> by_id(const std::vector<SweepRecord>& records, size_t& duplicates) {
   std::map<std::string, json> m;
   duplicates = 0;
-  for (const SweepRecord& r : records) duplicates += !m.emplace(r.point_id, without_timings(r)).second;
+  for (const SweepRecord& r : records) duplicates += !m.emplace(r.point_id, without_timings(to_json(r))).second;
   return m;
 }
 
@@ -482,7 +445,7 @@ TEST(SweepCli, KilledSweepResumesToTheSameRecords) {
   const size_t n_points = load_sweep(kSmoke).points.size();
 
   // Uninterrupted.
-  Exit e = run_tippe({"sweep", kSmoke, "--out", whole.string(), "--jobs", "2", "--no-plots"}, err);
+  ChildExit e = run_tippe({"sweep", kSmoke, "--out", whole.string(), "--jobs", "2", "--no-plots"}, err);
   ASSERT_EQ(e.code, 0) << slurp(err);
   size_t dup = 0;
   const auto reference = by_id(read_records((whole / "records.jsonl").string()).records, dup);
@@ -497,7 +460,7 @@ TEST(SweepCli, KilledSweepResumesToTheSameRecords) {
   while (count_lines(records) < 1 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   ::kill(pid, SIGKILL);
-  e = wait_tippe(pid);
+  e = wait_process(pid);
   ASSERT_EQ(e.signal, SIGKILL) << "the sweep finished before it could be killed: " << slurp(err);
   const size_t before = count_lines(records);
   ASSERT_GE(before, 1u);
@@ -544,7 +507,7 @@ TEST(SweepCli, ChangedSweepFileIsRefusedUnlessRestarted) {
   const fs::path out = dir.path() / "out", err = dir.path() / "err.txt";
   const std::string body = kGoodHead + kGoodSetup;
   const fs::path sweep = write_sweep(dir.path(), body);
-  Exit e = run_tippe({"sweep", sweep.string(), "--out", out.string(), "--jobs", "2", "--no-plots"}, err);
+  ChildExit e = run_tippe({"sweep", sweep.string(), "--out", out.string(), "--jobs", "2", "--no-plots"}, err);
   ASSERT_EQ(e.code, 0) << slurp(err);
   ASSERT_EQ(count_lines(out / "records.jsonl"), 2u);
   EXPECT_TRUE(fs::exists(out / "sweep.json"));
@@ -569,7 +532,7 @@ TEST(SweepCli, InvalidSweepExitsWithTwoAndWritesNothing) {
       write_sweep(dir.path(), kGoodHead +
                                   "[[setup]]\nname = \"mj\"\nengine = \"mujoco\"\n"
                                   "ladder.key = \"engines.mujoco.timestep\"\nladder.values = [1e-3, 2.0]\n");
-  Exit e = run_tippe({"sweep", bad.string(), "--out", out.string()}, err);
+  ChildExit e = run_tippe({"sweep", bad.string(), "--out", out.string()}, err);
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(slurp(err).find(bad.string() + ": setup[0].ladder.values[1]: engines.mujoco.timestep"), std::string::npos)
       << slurp(err);

@@ -1,12 +1,9 @@
 // Sweeps beyond one process: the task farm's contract, shards and their merge, and MPI runs (mpirun -np 2 and 3, killed and resumed) giving a local run's records.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -19,6 +16,8 @@
 #include "sweep.h"
 #include "task_farm.h"
 #include "test_files.h"
+#include "test_process.h"
+#include "test_records.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
@@ -32,46 +31,9 @@ const std::string kSmoke = kSource + "/harness/sweeps/smoke.toml";
 
 // ---- running the binary -----------------------------------------------------------------------
 
-// Starts argv with stdout and stderr into `log`; the child's pid.
-pid_t spawn(const std::vector<std::string>& argv, const fs::path& log) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    std::FILE* f = std::fopen(log.c_str(), "w");
-    if (f) {
-      ::dup2(::fileno(f), 1);
-      ::dup2(::fileno(f), 2);
-    }
-    std::vector<char*> args;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    ::execvp(args[0], args.data());
-    std::_Exit(127);
-  }
-  return pid;
-}
-
-// The exit code, or 128 + the signal that ended it.
-int wait_exit(pid_t pid) {
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-int run(const std::vector<std::string>& argv, const fs::path& log) { return wait_exit(spawn(argv, log)); }
-
-// wait_exit, but a child still running after `seconds` (a hung job) is killed and reported as -1.
-int wait_exit_within(pid_t pid, double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  int status = 0;
-  while (std::chrono::steady_clock::now() < end) {
-    const pid_t r = ::waitpid(pid, &status, WNOHANG);
-    if (r == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  ::kill(pid, SIGTERM);
-  wait_exit(pid);
-  return -1;
+// The command with stdout and stderr into `log`; its exit status (-1: ended by a signal).
+int run(const std::vector<std::string>& argv, const fs::path& log) {
+  return wait_process(spawn_process(argv, log, log)).code;
 }
 
 std::vector<std::string> tippe_sweep(std::vector<std::string> args) {
@@ -88,18 +50,6 @@ std::vector<json> lines_of(const fs::path& records) {
   for (std::string line; std::getline(in, line);)
     if (!line.empty()) out.push_back(json::parse(line));
   return out;
-}
-
-// A record without what differs from run to run of the same build: the CPU and wall times and
-// the ratios made from them.
-json without_timings(json r) {
-  for (const char* k : {"cpu_seconds", "cpu_seconds_repeats", "wall_seconds"}) r.erase(k);
-  if (r.contains("work"))
-    for (const char* k : {"cpu_seconds", "cpu_seconds_repeats", "wall_seconds"}) r["work"].erase(k);
-  if (r.contains("metrics"))
-    for (const char* k : {"cpu_seconds", "wall_seconds", "cost_ratio", "real_time_factor"}) r["metrics"].erase(k);
-  if (r.contains("reference") && r["reference"].is_object()) r["reference"].erase("cpu_seconds");
-  return r;
 }
 
 // point id -> record without timings; a point written twice fails the test.
@@ -373,9 +323,10 @@ TEST(SweepShards, AFailingReferenceStopsALocalSweepWithItsMessage) {
   TempDir dir("tippe-local-fail");
   const std::string sweep = failing_reference_sweep(dir);
   const fs::path log = dir.path() / "log";
-  EXPECT_EQ(wait_exit_within(spawn(tippe_sweep({sweep, "--out", (dir.path() / "out").string(), "--jobs", "2"}), log), 120),
-            1)
-      << slurp(log);
+  const ChildExit e = wait_process_within(
+      spawn_process(tippe_sweep({sweep, "--out", (dir.path() / "out").string(), "--jobs", "2"}), log, log), 120);
+  EXPECT_FALSE(e.timed_out) << "the sweep hung:\n" << slurp(log);
+  EXPECT_EQ(e.code, 1) << slurp(log);
   EXPECT_NE(slurp(log).find("reference run of"), std::string::npos) << slurp(log);
   EXPECT_TRUE(lines_of(dir.path() / "out" / "records.jsonl").empty());
 }
@@ -474,7 +425,7 @@ TEST(SweepMpi, AJobKilledMidwayCompletesWhenStartedAgainWithNothingLostOrTwice) 
                                                        "ladder.key = \"engines.ode.timestep\"\nladder.values = [" +
                                                        values + "]\n");
   const fs::path out = dir.path() / "out", log = dir.path() / "log";
-  const pid_t job = spawn(mpirun_sweep(3, {sweep, "--out", out.string()}), log);
+  const pid_t job = spawn_process(mpirun_sweep(3, {sweep, "--out", out.string()}), log, log);
   // Kill every rank (a node lost, a job cancelled) once some but not all points are in.
   size_t seen = 0;
   for (int i = 0; i < 12000 && seen < 3; ++i) {
@@ -485,7 +436,7 @@ TEST(SweepMpi, AJobKilledMidwayCompletesWhenStartedAgainWithNothingLostOrTwice) 
   const std::vector<pid_t> ranks = children_of(job);
   EXPECT_EQ(ranks.size(), 3u);
   for (pid_t r : ranks) ::kill(r, SIGKILL);
-  EXPECT_NE(wait_exit(job), 0) << "mpirun should report its killed ranks";
+  EXPECT_NE(wait_process(job).code, 0) << "mpirun should report its killed ranks";
   const size_t after_kill = lines_of(out / "records.jsonl").size();
   ASSERT_LT(after_kill, 12u) << "the job finished before it was killed; the test proves nothing";
 
@@ -535,9 +486,10 @@ TEST(SweepMpi, AReferenceFailingOnAWorkerStopsEveryRankWithItsMessage) {
   const std::string sweep = failing_reference_sweep(dir);
   const fs::path log = dir.path() / "log";
   for (int np : {2, 3}) {
-    const int rc = wait_exit_within(spawn(mpirun_sweep(np, {sweep, "--out", (dir.path() / "out").string()}), log), 120);
-    ASSERT_NE(rc, -1) << "the job hung:\n" << slurp(log);
-    EXPECT_EQ(rc, 1) << slurp(log);
+    const ChildExit e =
+        wait_process_within(spawn_process(mpirun_sweep(np, {sweep, "--out", (dir.path() / "out").string()}), log, log), 120);
+    ASSERT_FALSE(e.timed_out) << "the job hung:\n" << slurp(log);
+    EXPECT_EQ(e.code, 1) << slurp(log);
     const std::string text = slurp(log);
     EXPECT_NE(text.find("reference run of"), std::string::npos) << text;
     EXPECT_EQ(text.find("tippe: error: "), text.rfind("tippe: error: ")) << "printed more than once:\n" << text;
