@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -17,7 +18,6 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 #include <unistd.h>
 
 #include "adapters.h"
@@ -25,6 +25,7 @@
 #include "provenance.h"
 #include "report.h"
 #include "scene_io.h"
+#include "task_farm.h"
 
 namespace tippe {
 
@@ -675,32 +676,16 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
   }
 
   // Each simulator is built, run and destroyed on one worker thread (ODE's per-thread state).
-  std::atomic<size_t> next{0};
-  std::atomic<size_t> finished{0};
-  auto worker = [&] {
-    for (size_t k; (k = next.fetch_add(1)) < todo.size();) {
-      run_task(tasks[todo[k]], scene, board, todo[k]);
-      finished.fetch_add(1);
-    }
-  };
-  const size_t n_threads = std::min(static_cast<size_t>(options.jobs), std::max<size_t>(todo.size(), 1));
-  std::vector<std::thread> pool;
-  for (size_t i = 0; i < n_threads; ++i) pool.emplace_back(worker);
+  // run_task keeps a run's exception in its task (t.fatal), so every run is attempted.
+  // Five redraws a second is enough to see motion without flooding a CI log.
+  std::function<void()> redraw;
+  if (options.progress) redraw = [&] { board.print(); };
+  parallel_for(
+      todo.size(), options.jobs, [&](size_t k) { run_task(tasks[todo[k]], scene, board, todo[k]); }, redraw);
   if (options.progress) {
-    // Five redraws a second is enough to see motion without flooding a CI log; the short naps
-    // end the wait soon after the last run.
-    auto last = std::chrono::steady_clock::now() - std::chrono::seconds(1);
-    while (finished.load() < todo.size()) {
-      if (std::chrono::steady_clock::now() - last >= std::chrono::milliseconds(200)) {
-        board.print();
-        last = std::chrono::steady_clock::now();
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
     board.print();
     std::fputc('\n', stderr);
   }
-  for (auto& th : pool) th.join();
 
   for (const Task& t : tasks)
     if (t.fatal) std::rethrow_exception(t.fatal);

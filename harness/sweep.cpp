@@ -70,7 +70,6 @@ bool is_name(const std::string& n) {
 
 std::string idx(const std::string& key, size_t i) { return key + "[" + std::to_string(i) + "]"; }
 
-
 // Checks one sweep file; every message names the file and the dotted key.
 class SweepReader {
  public:
@@ -604,7 +603,6 @@ namespace {
 struct Reference {
   RunRecord record;
   Trajectory trajectory;
-  bool cached = false;
   std::optional<SweepRecord::ReferenceRun> summary;  // filled once loaded or computed
 };
 
@@ -624,11 +622,6 @@ SweepRecord::ReferenceRun reference_summary(const Scene& scene, const Reference&
   return f;
 }
 
-// The comparison cache's rule (load_cached_reference): same physics, same build, complete files.
-bool load_reference(const fs::path& dir, const Scene& scene, const std::string& hash, Reference& ref) {
-  ref.cached = load_cached_reference(dir, scene, hash, ref.record, ref.trajectory);
-  return ref.cached;
-}
 
 // The reference's two cache files as texts, "summary.json" then "trajectory.csv", each behind its
 // length: what a worker sends back and what the coordinator shares with every rank.
@@ -1133,7 +1126,8 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<D
       p.needed.push_back(i);
   for (size_t i : p.needed) {
     const fs::path dir = out / "reference" / plan.physics_hashes[i];
-    if (load_reference(dir, plan.scenes[i], plan.physics_hashes[i], refs[i]))
+    // The comparison cache's rule: same physics, same build, complete files.
+    if (load_cached_reference(dir, plan.scenes[i], plan.physics_hashes[i], refs[i].record, refs[i].trajectory))
       ++p.cached;
     else
       p.to_compute.push_back(i);
