@@ -1135,6 +1135,28 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<D
   return p;
 }
 
+// Runs `make` on the coordinator and gives its result to every rank. When it throws, every rank
+// throws the same: a SweepInputError as one, anything else as std::runtime_error with its text.
+std::string from_coordinator(TaskFarm& farm, const std::function<std::string()>& make) {
+  std::string message;
+  if (farm.coordinator()) {
+    try {
+      message = "ok\n" + make();
+    } catch (const SweepInputError& e) {
+      message = std::string("input\n") + e.what();
+    } catch (const std::exception& e) {
+      message = std::string("error\n") + e.what();
+    }
+  }
+  farm.broadcast(message);
+  const size_t nl = message.find('\n');
+  const std::string kind = message.substr(0, nl);
+  message.erase(0, nl + 1);
+  if (kind == "input") throw SweepInputError(message);
+  if (kind != "ok") throw std::runtime_error(message);
+  return message;
+}
+
 }  // namespace
 
 SweepShard parse_shard(const std::string& text) {
@@ -1186,23 +1208,11 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
   // 1. The coordinator decides; its decision (or its refusal) reaches every rank.
   std::unique_ptr<DirLock> lock;
   Prepared prep;
-  std::string message;
-  if (farm.coordinator()) {
-    try {
-      prep = prepare(plan, o, lock, refs);
-      message = "ok\n" + encode(prep);
-    } catch (const SweepInputError& e) {
-      message = std::string("input\n") + e.what();
-    } catch (const std::exception& e) {
-      message = std::string("error\n") + e.what();
-    }
-  }
-  farm.broadcast(message);
-  const size_t nl = message.find('\n');
-  const std::string kind = message.substr(0, nl), rest = message.substr(nl + 1);
-  if (kind == "input") throw SweepInputError(rest);
-  if (kind != "ok") throw std::runtime_error(rest);
-  if (!farm.coordinator()) prep = decode(rest);
+  const std::string decision = from_coordinator(farm, [&] {
+    prep = prepare(plan, o, lock, refs);
+    return encode(prep);
+  });
+  if (!farm.coordinator()) prep = decode(decision);
 
   SweepOutcome outcome;
   outcome.points = prep.share;
@@ -1223,24 +1233,19 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
 
   // 3. Every rank gets the same texts of every reference it needs, and reads them the way the cache is read.
   if (farm.distributed()) {
-    std::string bytes = "ok\n";
-    if (farm.coordinator()) {
-      try {
-        for (size_t i : prep.needed) {
-          const fs::path dir = out / "reference" / plan.physics_hashes[i];
-          bytes += pack_texts(read_file_text((dir / "summary.json").string()),
-                              read_file_text((dir / "trajectory.csv").string()));
-        }
-      } catch (const std::exception& e) {
-        bytes = std::string("error\n") + e.what();
+    const std::string bytes = from_coordinator(farm, [&] {
+      std::string texts;
+      for (size_t i : prep.needed) {
+        const fs::path dir = out / "reference" / plan.physics_hashes[i];
+        texts += pack_texts(read_file_text((dir / "summary.json").string()),
+                            read_file_text((dir / "trajectory.csv").string()));
       }
-    }
-    farm.broadcast(bytes);
-    if (bytes.compare(0, 3, "ok\n") != 0) throw std::runtime_error(bytes.substr(bytes.find('\n') + 1));
+      return texts;
+    });
     std::string error;
     if (!farm.coordinator()) {
       try {
-        size_t pos = 3;
+        size_t pos = 0;
         for (size_t i : prep.needed) {
           const auto [summary, csv] = unpack_texts(bytes, pos);
           const std::string why = reference_from_text(summary, csv, plan.scenes[i], plan.physics_hashes[i],
