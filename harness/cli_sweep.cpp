@@ -96,10 +96,10 @@ void print_outcome(const SweepOutcome& r, const SweepOptions& opts, const std::s
 
 int run_local(const SweepCliOptions& o) {
   if (o.sweep.empty()) throw UsageError("a sweep file is required (or --report DIR, or --merge DIR...)");
-  SweepOptions opts = run_options(o, 0);
+  const SweepOptions opts =
+      run_options(o, o.jobs > 0 ? o.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency())));
   // Every scene and point is loaded and checked before the output directory is touched.
   const SweepPlan plan = load_sweep(o.sweep);
-  opts.jobs = o.jobs > 0 ? o.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   SweepOutcome r;
   try {
     r = run_sweep(plan, opts);
@@ -117,7 +117,7 @@ int run_mpi(const SweepCliOptions& o, const MpiSession& mpi) {
   if (o.jobs)
     throw UsageError("--jobs is for a run in one process; under mpirun rank 0 hands out the points and every "
                      "other rank runs one at a time (start as many ranks as cores, plus one)");
-  SweepOptions opts = run_options(o, 1);
+  const SweepOptions opts = run_options(o, 1);
   auto farm = make_mpi_farm(mpi);
   // Every rank reads the sweep itself; they must all have read the same one (a node with other
   // files, or another checkout, would make other records).
@@ -155,6 +155,13 @@ int run_mpi(const SweepCliOptions& o, const MpiSession& mpi) {
 }
 #endif
 
+// --merge, --report or a sweep on threads.
+int in_one_process(const SweepCliOptions& o) {
+  if (!o.merge.empty()) return merge(o);
+  if (!o.report_dir.empty()) return report_only(o);
+  return run_local(o);
+}
+
 int sweep(const SweepCliOptions& o) {
   const int launched = mpi_launch_size();
 #ifdef TIPPE_HAVE_MPI
@@ -162,7 +169,8 @@ int sweep(const SweepCliOptions& o) {
   std::unique_ptr<MpiSession> mpi;
   if (launched > 0) mpi = std::make_unique<MpiSession>();
   if (mpi && mpi->size() > 1) {
-    if (!o.merge.empty() || !o.report_dir.empty()) return mpi->rank() == 0 ? (o.merge.empty() ? report_only(o) : merge(o)) : 0;
+    // --merge and --report write one directory: rank 0 does them alone.
+    if (!o.merge.empty() || !o.report_dir.empty()) return mpi->rank() == 0 ? in_one_process(o) : 0;
     // The other ranks' errors are rank 0's too (every step agrees), so only rank 0 prints them,
     // and before MPI_Finalize: no rank leaves that before all arrive, so the launcher cannot
     // kill rank 0 for another rank's exit code while its message is half written.
@@ -177,9 +185,7 @@ int sweep(const SweepCliOptions& o) {
     throw UsageError("this tippe was built without MPI but started as one of " + std::to_string(launched) +
                      " ranks; install libopenmpi-dev and rebuild (bash scripts/build.sh), or run without mpirun");
 #endif
-  if (!o.merge.empty()) return merge(o);
-  if (!o.report_dir.empty()) return report_only(o);
-  return run_local(o);
+  return in_one_process(o);
 }
 
 }  // namespace
