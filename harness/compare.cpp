@@ -345,6 +345,8 @@ json to_json(const Comparison& c) {
     engines.push_back(
         {{"engine", e.run.engine}, {"summary", summary_with_bounded_events(e.run)}, {"metrics", to_json(e.metrics)}});
   }
+  json provenance_with_versions = to_json(c.provenance);
+  provenance_with_versions["engine_versions"] = versions;
   return json{
       {"format", "tippe-comparison-1"},
       {"scene_name", c.scene.value("name", "")},
@@ -352,13 +354,7 @@ json to_json(const Comparison& c) {
       {"scene_hash", c.scene.value("content_hash", "")},
       {"physics_hash", physics_hash(c.scene)},
       {"scene", c.scene},
-      {"provenance",
-       {{"git_commit", c.provenance.git_commit},
-        {"compiler", c.provenance.compiler},
-        {"cxx_flags", c.provenance.cxx_flags},
-        {"date", c.provenance.date},
-        {"hostname", c.provenance.hostname},
-        {"engine_versions", versions}}},
+      {"provenance", provenance_with_versions},
       {"reference", {{"cached", c.reference_cached}, {"summary", summary_with_bounded_events(c.reference)}}},
       {"engines", engines},
   };
@@ -367,10 +363,7 @@ json to_json(const Comparison& c) {
 Comparison comparison_from_json(const json& j) {
   Comparison c;
   c.scene = j.at("scene");
-  const json& p = j.at("provenance");
-  c.provenance = {p.at("git_commit").get<std::string>(), p.at("compiler").get<std::string>(),
-                  p.at("cxx_flags").get<std::string>(), p.at("date").get<std::string>(),
-                  p.at("hostname").get<std::string>()};
+  c.provenance = provenance_from_json(j.at("provenance"));
   c.reference = from_json(j.at("reference").at("summary"));
   c.reference_cached = j.at("reference").at("cached").get<bool>();
   for (const json& e : j.at("engines")) c.engines.push_back({from_json(e.at("summary")), metrics_from_json(e.at("metrics"))});

@@ -215,13 +215,21 @@ json to_json(const RunRecord& r) {
       {"events", events},
       {"settings", settings},
       {"notes", r.notes},
-      {"provenance",
-       {{"git_commit", r.provenance.git_commit},
-        {"compiler", r.provenance.compiler},
-        {"cxx_flags", r.provenance.cxx_flags},
-        {"date", r.provenance.date},
-        {"hostname", r.provenance.hostname}}},
+      {"provenance", to_json(r.provenance)},
   };
+}
+
+json to_json(const Provenance& p) {
+  return {{"git_commit", p.git_commit},
+          {"compiler", p.compiler},
+          {"cxx_flags", p.cxx_flags},
+          {"date", p.date},
+          {"hostname", p.hostname}};
+}
+
+Provenance provenance_from_json(const json& p) {
+  return {p.at("git_commit").get<std::string>(), p.at("compiler").get<std::string>(),
+          p.at("cxx_flags").get<std::string>(), p.at("date").get<std::string>(), p.at("hostname").get<std::string>()};
 }
 
 long long json_integer(const json& j, const char* key) {
@@ -273,10 +281,7 @@ RunRecord from_json(const json& j) {
                         get_number(e, "value")});
   for (const auto& [k, v] : j.at("settings").items()) r.settings.emplace_back(k, v.get<std::string>());
   r.notes = j.at("notes").get<std::vector<std::string>>();
-  const json& p = j.at("provenance");
-  r.provenance = {p.at("git_commit").get<std::string>(), p.at("compiler").get<std::string>(),
-                  p.at("cxx_flags").get<std::string>(), p.at("date").get<std::string>(),
-                  p.at("hostname").get<std::string>()};
+  r.provenance = provenance_from_json(j.at("provenance"));
   return r;
 }
 

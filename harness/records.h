@@ -23,6 +23,10 @@ struct Provenance {
 };
 // Build info plus the current date and host.
 Provenance current_provenance();
+// The "provenance" object of every record (run, comparison, sweep); the reader throws
+// nlohmann::json::exception for a missing or mistyped field.
+nlohmann::json to_json(const Provenance& p);
+Provenance provenance_from_json(const nlohmann::json& j);
 
 // Everything a run leaves behind except its trajectory.
 struct RunRecord {

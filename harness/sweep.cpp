@@ -971,12 +971,7 @@ json sweep_json(const SweepPlan& plan, const json& shard) {
               {"setups", setups},
               {"sweep_text", plan.spec.text},
               {"shard", shard},
-              {"provenance",
-               {{"git_commit", p.git_commit},
-                {"compiler", p.compiler},
-                {"cxx_flags", p.cxx_flags},
-                {"date", p.date},
-                {"hostname", p.hostname}}}};
+              {"provenance", to_json(p)}};
 }
 
 

@@ -29,8 +29,6 @@ struct ShardDir {
 
 [[noreturn]] void refuse(const std::string& why) { throw SweepInputError(why); }
 
-std::string where(const fs::path& dir) { return dir.string(); }
-
 std::string number_text(double v) {
   std::ostringstream ss;
   ss << v;
@@ -42,7 +40,7 @@ ShardDir read_shard(const fs::path& dir) {
   s.dir = dir;
   const fs::path meta = dir / "sweep.json", records = dir / "records.jsonl";
   std::error_code ec;
-  if (!fs::is_regular_file(meta, ec)) refuse(where(dir) + ": no sweep.json (not a sweep directory)");
+  if (!fs::is_regular_file(meta, ec)) refuse(dir.string() + ": no sweep.json (not a sweep directory)");
   try {
     std::ifstream in(meta);
     s.meta = json::parse(in);
@@ -99,16 +97,16 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
   for (const ShardDir& s : shards) {
     const std::string h = s.meta["sweep_hash"], ph = s.meta["plan_hash"];
     if (h != sweep_hash)
-      refuse(where(s.dir) + ": sweep_hash: a shard of another sweep file (" + h + ", " + where(first.dir) +
+      refuse(s.dir.string() + ": sweep_hash: a shard of another sweep file (" + h + ", " + first.dir.string() +
              " has " + sweep_hash + ")");
     if (ph != plan_hash)
-      refuse(where(s.dir) + ": plan_hash: a shard of the same sweep file over other scene physics (" + ph + ", " +
-             where(first.dir) + " has " + plan_hash + ")");
+      refuse(s.dir.string() + ": plan_hash: a shard of the same sweep file over other scene physics (" + ph + ", " +
+             first.dir.string() + " has " + plan_hash + ")");
     if (s.count != first.count)
-      refuse(where(s.dir) + ": shard: " + shard_name(s) + " is of another split than " + where(first.dir) + "'s " +
+      refuse(s.dir.string() + ": shard: " + shard_name(s) + " is of another split than " + first.dir.string() + "'s " +
              shard_name(first));
     auto [it, fresh] = by_index.emplace(s.index, &s);
-    if (!fresh) refuse(where(s.dir) + ": shard " + shard_name(s) + " given twice (also " + where(it->second->dir) + ")");
+    if (!fresh) refuse(s.dir.string() + ": shard " + shard_name(s) + " given twice (also " + it->second->dir.string() + ")");
   }
   std::string missing;
   for (int i = 0; i < first.count; ++i)
@@ -125,17 +123,17 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
     std::set<std::string> seen;
     for (const SweepRecord& r : s.records) {
       if (!own.count(r.point_id))
-        refuse(where(s.dir / "records.jsonl") + ": point " + r.point_id + " (" + r.scene + ", " + r.setup + ", " +
+        refuse((s.dir / "records.jsonl").string() + ": point " + r.point_id + " (" + r.scene + ", " + r.setup + ", " +
                r.ladder_key + " = " + number_text(r.ladder_value) + ") is not of shard " + shard_name(s));
       if (!seen.insert(r.point_id).second) continue;  // a duplicate line: the first counts, as in the report
       merged.push_back(&r);
       commits.insert(r.git_commit);
     }
     if (seen.size() != own.size())
-      refuse(where(s.dir) + ": " + std::to_string(own.size() - seen.size()) + " of " + std::to_string(own.size()) +
+      refuse(s.dir.string() + ": " + std::to_string(own.size() - seen.size()) + " of " + std::to_string(own.size()) +
              " points of shard " + shard_name(s) + " unfinished; run the shard again to finish it");
     for (const std::string& id : own)
-      if (!all_ids.insert(id).second) refuse(where(s.dir) + ": point " + id + " is also in another shard");
+      if (!all_ids.insert(id).second) refuse(s.dir.string() + ": point " + id + " is also in another shard");
   }
   if (all_ids.size() != first.meta["points"].get<size_t>())
     refuse("the shards hold " + std::to_string(all_ids.size()) + " points, the sweep has " +
@@ -180,9 +178,7 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
   for (const auto& [i, s] : by_index)
     from.push_back({{"dir", s->dir.string()}, {"index", i}, {"provenance", s->meta.value("provenance", json())}});
   meta["merged_from"] = from;
-  const Provenance p = current_provenance();
-  meta["provenance"] = {{"git_commit", p.git_commit}, {"compiler", p.compiler}, {"cxx_flags", p.cxx_flags},
-                        {"date", p.date},             {"hostname", p.hostname}};
+  meta["provenance"] = to_json(current_provenance());
   write_file_atomic(meta_file.string(), meta.dump(2) + "\n");
 
   // The references, so that a later `tippe sweep SWEEP --out DIR` finds them cached.
