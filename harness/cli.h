@@ -10,6 +10,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "interrupt.h"
+#include "output_dir.h"
 #include "scene_io.h"
 
 namespace tippe::cli {
@@ -21,8 +23,7 @@ class UsageError : public std::runtime_error {
 };
 
 // A subcommand adds itself to the app and returns what to run once the command line is parsed.
-// The action returns the exit code; exceptions are mapped by main (SceneError, UsageError -> 2,
-// anything else -> 1).
+// The action returns the exit code; exceptions are mapped by main (error_exit).
 using Action = std::function<int()>;
 struct Command {
   CLI::App* sub = nullptr;
@@ -30,8 +31,10 @@ struct Command {
 };
 using Setup = Command (*)(CLI::App& app);
 
-// A subcommand's exception as an exit code (SceneError, UsageError -> 2, anything else -> 1),
-// its message on stderr when `print`.
+// A subcommand's exception as an exit code, its message on stderr when `print`: bad input
+// (SceneError, UsageError) and an unusable output path (OutputError) -> 2; a signal that ended
+// the command cleanly (Interrupted) -> 128 + its number, as a shell reports a signal; anything
+// else is a bug -> 1, said as "internal".
 inline int error_exit(const std::exception_ptr& e, bool print = true) {
   try {
     std::rethrow_exception(e);
@@ -41,6 +44,12 @@ inline int error_exit(const std::exception_ptr& e, bool print = true) {
   } catch (const UsageError& x) {
     if (print) std::cerr << "tippe: error: " << x.what() << "\n";
     return 2;
+  } catch (const OutputError& x) {
+    if (print) std::cerr << "tippe: error: " << x.what() << "\n";
+    return 2;
+  } catch (const Interrupted& x) {
+    if (print) std::cerr << "tippe: " << x.what() << "; no output half-written\n";
+    return 128 + x.signal();
   } catch (const std::exception& x) {
     if (print) std::cerr << "tippe: error: internal: " << x.what() << "\n";
     return 1;

@@ -39,18 +39,23 @@ int compare(const CompareCliOptions& o) {
   opts.engines = o.engines;
   const int runs = static_cast<int>(o.engines.size()) + 1;
   opts.jobs = o.jobs > 0 ? o.jobs : std::max(1, std::min(runs, static_cast<int>(std::thread::hardware_concurrency())));
-  opts.out_dir = o.out.empty() ? (fs::path("out") / (scene.name + "-compare")).string() : o.out;
+  const fs::path dir = o.out.empty() ? fs::path("out") / (scene.name + "-compare") : fs::path(o.out);
   opts.cache_dir = o.no_cache ? "" : o.cache;
   opts.plots = !o.no_plots;
-  Comparison c;
+  // run_comparison checks its input before it writes anything; so does this, before DIR exists.
   try {
-    c = run_comparison(scene, opts);
+    check_compare_input(scene, opts);
   } catch (const std::invalid_argument& e) {
-    // run_comparison checks its input before it writes anything.
     throw UsageError(e.what());
   }
+  // The comparison's files are one unit, written beside DIR and swapped in whole.
+  const InterruptGuard interrupts;
+  OutputDir out(dir);
+  opts.out_dir = out.stage(false).string();
+  const Comparison c = run_comparison(scene, opts);
+  out.commit();
   print_table_and_findings(to_json(c));
-  std::printf("report: %s\n", (fs::path(opts.out_dir) / "index.html").string().c_str());
+  std::printf("report: %s\n", (dir / "index.html").string().c_str());
   return 0;
 }
 
@@ -64,12 +69,18 @@ int report(const std::string& dir, bool no_plots, bool summary_line) {
     comparison_from_json(j);  // checks that every field the report reads is there
   } catch (const nlohmann::json::exception& e) {
     throw UsageError(file.string() + ": not a comparison record: " + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(file.string() + ": " + e.what());
   }
   if (summary_line) {
     std::printf("%s\n", render_summary_line(j).c_str());
     return 0;
   }
-  write_report(dir, j, !no_plots);
+  // The rebuilt report replaces the old one as a unit; the records stay as they are.
+  const InterruptGuard interrupts;
+  OutputDir out(dir);
+  write_report(out.stage(true).string(), j, !no_plots);
+  out.commit();
   print_table_and_findings(j);
   std::printf("report: %s\n", (fs::path(dir) / "index.html").string().c_str());
   return 0;

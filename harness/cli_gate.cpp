@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "compare.h"
 #include "gate.h"
+#include "output_dir.h"
 #include "records.h"
 #include "scene_io.h"
 
@@ -37,21 +38,8 @@ struct Group {
 // not cost a whole gate run.
 void check_output(const std::string& path, const char* option) {
   if (path.empty()) return;
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw UsageError(std::string(option) + ": " + path + " is a directory");
-  for (fs::path p = fs::path(path).parent_path(); !p.empty(); p = p.parent_path()) {
-    if (fs::exists(p, ec)) {
-      if (!fs::is_directory(p, ec)) throw UsageError(std::string(option) + ": " + p.string() + " is not a directory");
-      break;
-    }
-    if (p == p.parent_path()) break;
-  }
-}
-
-void write_output(const std::string& path, const std::string& text) {
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty()) fs::create_directories(parent);
-  write_file_atomic(path, text);
+  if (const std::string problem = result_file_problem(path); !problem.empty())
+    throw UsageError(std::string(option) + ": " + path + ": " + problem);
 }
 
 int gate(const GateCliOptions& o) {
@@ -60,7 +48,9 @@ int gate(const GateCliOptions& o) {
   const GateFile g = load_gate_file(o.gates);
   check_output(o.junit, "--junit");
   check_output(o.json, "--json");
-  if (!o.junit.empty() && fs::path(o.junit).lexically_normal() == fs::path(o.json).lexically_normal())
+  std::error_code ec;
+  if (!o.junit.empty() && !o.json.empty() &&
+      fs::weakly_canonical(fs::absolute(o.junit), ec) == fs::weakly_canonical(fs::absolute(o.json), ec))
     throw UsageError("--junit and --json name the same file " + o.junit);
 
   std::vector<Group> groups;
@@ -115,11 +105,11 @@ int gate(const GateCliOptions& o) {
 
   std::printf("%s", render_table(results).c_str());
   std::fflush(stdout);
-  if (!o.junit.empty()) write_output(o.junit, render_junit(results, o.gates));
+  if (!o.junit.empty()) write_result_file(o.junit, render_junit(results, o.gates));
   if (!o.json.empty()) {
     nlohmann::json j = to_json(results);
     j["gate_file"] = o.gates;
-    write_output(o.json, j.dump(2) + "\n");
+    write_result_file(o.json, j.dump(2) + "\n");
   }
   return all_passed(results) ? 0 : 1;
 }

@@ -58,24 +58,6 @@ class ProgressLine {
   std::chrono::steady_clock::time_point last_;
 };
 
-// Removes the output directory on failure when this run created it and nothing is in it.
-class DirGuard {
- public:
-  explicit DirGuard(const fs::path& dir) : dir_(dir) {
-    created_ = !fs::exists(dir_);
-    fs::create_directories(dir_);
-  }
-  ~DirGuard() {
-    std::error_code ec;
-    if (!done_ && created_ && fs::is_empty(dir_, ec)) fs::remove(dir_, ec);
-  }
-  void done() { done_ = true; }
-
- private:
-  fs::path dir_;
-  bool created_ = false, done_ = false;
-};
-
 std::string opt_time(const std::optional<double>& t) {
   if (!t) return "none";
   char buf[64];
@@ -124,15 +106,19 @@ int run(const RunOptions& o) {
   }
   const fs::path dir = o.out.empty() ? fs::path("out") / (scene.name + "-" + o.engine) : fs::path(o.out);
 
-  DirGuard guard(dir);
-  CsvTrajectoryWriter csv((dir / "trajectory.csv").string());
+  // The run's files are one unit: written beside DIR and swapped in whole, so that an
+  // interrupted rerun (a signal, a full disk) leaves the earlier run's files as they were.
+  const InterruptGuard interrupts;
+  OutputDir out(dir);
+  const fs::path stage = out.stage(false);
+  CsvTrajectoryWriter csv((stage / "trajectory.csv").string());
   ProgressLine progress(o.engine);
   const RunRecord record =
       run_simulator(*sim, scene, &csv, [&progress](double t, double duration) { progress.update(t, duration); });
   progress.finish();
   csv.commit();
-  write_file_atomic((dir / "summary.json").string(), to_json(record).dump(2) + "\n");
-  guard.done();
+  write_file_atomic((stage / "summary.json").string(), to_json(record).dump(2) + "\n");
+  out.commit();
   print_summary(record, dir);
   return 0;
 }

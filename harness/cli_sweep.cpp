@@ -35,9 +35,14 @@ int report_only(const SweepCliOptions& o) {
   const fs::path records = fs::path(o.report_dir) / "records.jsonl";
   std::error_code ec;
   if (!fs::is_regular_file(records, ec)) throw UsageError(records.string() + ": cannot read (not a sweep directory?)");
+  // Locked like every output directory: a report is not rebuilt under a sweep still running.
+  const InterruptGuard interrupts;
+  OutputDir dir(o.report_dir);
   RecordsFile f;
   try {
     f = read_records(records.string());
+  } catch (const SweepInputError& e) {
+    throw UsageError(e.what());
   } catch (const std::runtime_error& e) {
     throw UsageError(e.what());
   }
@@ -45,7 +50,9 @@ int report_only(const SweepCliOptions& o) {
   if (f.partial_bytes)
     std::fprintf(stderr, "tippe: note: %s ends in a partial line (%zu bytes), left out of the report\n",
                  records.string().c_str(), f.partial_bytes);
-  write_sweep_report(o.report_dir, f.records, !o.no_plots);
+  // The rebuilt report replaces the old one as a unit; the records stay as they are.
+  write_sweep_report(dir.stage(true).string(), f.records, !o.no_plots);
+  dir.commit();
   std::printf("report: %s (%zu points)\n", (fs::path(o.report_dir) / "index.html").string().c_str(), f.records.size());
   return 0;
 }
@@ -199,7 +206,7 @@ Command setup_sweep(CLI::App& app) {
   sub->add_option("--jobs,-j", o->jobs, "Runs in parallel (default: one per core)")->check(CLI::PositiveNumber);
   sub->add_flag("--restart", o->restart,
                 "Begin the output directory again (needed when the sweep file or a scene's physics changed); "
-                "earlier records are kept as records.jsonl.old");
+                "earlier records are kept as records.jsonl.old (.old.2, ... when that exists)");
   sub->add_option("--report", o->report_dir, "Only rebuild DIR's report from DIR/records.jsonl");
   sub->add_option("--shard", o->shard,
                   "Run only share I of N (I/N, 0-based) of the points, e.g. a job array's index; "

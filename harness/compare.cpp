@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "adapters.h"
+#include "interrupt.h"
 #include "mass_properties.h"
 #include "provenance.h"
 #include "report.h"
@@ -360,7 +361,34 @@ json to_json(const Comparison& c) {
   };
 }
 
+namespace {
+
+// A name read back from a record names files (ENGINE.csv) and appears in reports: it must pass
+// the rule of names in input files, or a shared record could write outside its directory.
+void check_record_name(const json& j, const char* key, const std::string& where) {
+  const std::string name = j.at(key).get<std::string>();
+  if (!is_valid_name(name))
+    throw std::invalid_argument(where + key + ": \"" + name + "\" is not a usable name (" + kNameRule + ")");
+}
+
+}  // namespace
+
 Comparison comparison_from_json(const json& j) {
+  check_record_name(j, "scene_name", "");
+  check_record_name(j.at("reference").at("summary"), "engine", "reference.summary.");
+  std::set<std::string> engines;
+  for (size_t i = 0; i < j.at("engines").size(); ++i) {
+    const json& e = j.at("engines").at(i);
+    const std::string where = "engines[" + std::to_string(i) + "].";
+    check_record_name(e, "engine", where);
+    check_record_name(e.at("summary"), "engine", where + "summary.");
+    if (e.at("engine") != e.at("summary").at("engine"))
+      throw std::invalid_argument(where + "engine: \"" + e.at("engine").get<std::string>() +
+                                  "\" differs from its summary's engine");
+    if (!engines.insert(e.at("engine").get<std::string>()).second || e.at("engine") == "reference")
+      throw std::invalid_argument(where + "engine: \"" + e.at("engine").get<std::string>() +
+                                  "\" appears twice (each names its own trajectory file)");
+  }
   Comparison c;
   c.scene = j.at("scene");
   c.provenance = provenance_from_json(j.at("provenance"));
@@ -525,6 +553,11 @@ void run_task(Task& task, const Scene& scene, ProgressBoard& board, size_t slot)
   TrajectorySink sink({&out, &cache});
   try {
     task.record = run_simulator(*sim, scene, &sink, [&](double t, double) { board.set_time(slot, t); });
+  } catch (const Interrupted&) {
+    // A signal ends the comparison, not this run: nothing of it is recorded.
+    task.fatal = std::current_exception();
+    board.stopped(slot, "interrupted");
+    return;
   } catch (...) {
     if (out.error) {
       task.fatal = out.error;
@@ -610,8 +643,7 @@ std::string reference_from_text(const std::string& summary_json, const std::stri
   }
 }
 
-Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
-  // Every check on the input comes before the first file is written.
+void check_compare_input(const Scene& scene, const CompareOptions& options) {
   if (options.engines.empty()) throw std::invalid_argument("no engines to compare");
   if (options.jobs < 1) throw std::invalid_argument("jobs must be at least 1, got " + std::to_string(options.jobs));
   const std::vector<std::string> known = available_engines();
@@ -625,6 +657,11 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
     if (!seen.insert(e).second) throw std::invalid_argument("engine \"" + e + "\" listed twice");
   }
   validate_engine_settings(scene);
+}
+
+Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
+  // Every check on the input comes before the first file is written.
+  check_compare_input(scene, options);
 
   Comparison c;
   c.scene = scene_to_json(scene);

@@ -108,6 +108,9 @@ struct Comparison {
 // before any file is written. A cache entry is used only when its summary has the same physics
 // hash, git commit and reference version as this build; otherwise it is re-run and replaced.
 Comparison run_comparison(const Scene& scene, const CompareOptions& options);
+// The checks run_comparison makes before it writes anything (engines known and listed once, jobs,
+// engine settings): throws std::invalid_argument as it does.
+void check_compare_input(const Scene& scene, const CompareOptions& options);
 // comparison.json: {"format", "scene_name", "scene_file", "scene_hash", "physics_hash", "scene",
 // "provenance" (with "engine_versions"), "reference": {"cached", "summary"}, "engines":
 // [{"engine", "summary", "metrics"}, ...]}; summaries are to_json(RunRecord), except that only
@@ -115,7 +118,9 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options);
 // "events_omitted": {"switch": N}.
 inline constexpr long long kMaxSwitchEventsKept = 100;
 nlohmann::json to_json(const Comparison& c);
-// Throws nlohmann::json::exception for a missing or mistyped field.
+// Throws nlohmann::json::exception for a missing or mistyped field, std::invalid_argument
+// ("KEY: reason") for a scene or engine name that breaks is_valid_name, an engine twice, or an
+// engine named "reference": the names become file names in the record's directory.
 Comparison comparison_from_json(const nlohmann::json& j);
 
 // Hash of the physics of a scene (everything but the engine settings and the name): the key of

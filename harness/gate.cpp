@@ -50,13 +50,6 @@ std::string trim(const std::string& s) {
   return s.substr(b, e - b + 1);
 }
 
-bool is_name(const std::string& n) {
-  return !n.empty() && std::all_of(n.begin(), n.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
-           c == '.';
-  });
-}
-
 std::string idx(const std::string& key, size_t i) { return key + "[" + std::to_string(i) + "]"; }
 
 std::string join(const std::vector<std::string>& v, const std::string& sep) {
@@ -158,7 +151,7 @@ class GateReader {
     s.key = key;
     if (const toml::node* n = t.get("name")) {
       s.name = string(*n, key + ".name");
-      if (!is_name(*s.name))
+      if (!is_valid_name(*s.name))
         fail(key + ".name", "\"" + *s.name + "\" is not a usable name (letters, digits, '.', '_', '-')");
     }
     if (const toml::node* n = t.get("scene")) {

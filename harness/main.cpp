@@ -30,8 +30,12 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  install_interrupt_handlers();
   try {
-    return actions.at(app.get_subcommands().front())();
+    const int code = actions.at(app.get_subcommands().front())();
+    // A signal deferred while the last unit was committed still ends the command as a signal.
+    check_interrupted();
+    return code;
   } catch (const std::exception&) {
     return cli::error_exit(std::current_exception());
   }

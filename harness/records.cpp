@@ -19,6 +19,7 @@
 #include <stdexcept>
 
 #include "mass_properties.h"
+#include "interrupt.h"
 #include "provenance.h"
 #include "scene_io.h"
 
@@ -141,6 +142,8 @@ RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, Pr
     if (sink) sink->write(o);
     last_t = o.state.t;
     if (progress) progress(o.state.t, T);
+    // Between samples a deferred SIGINT or SIGTERM ends the run (see interrupt.h).
+    check_interrupted();
   };
   emit(sim.observe());
   for (long long k = 1; k <= n && sim.status() == RunStatus::Ok; ++k) {
@@ -288,12 +291,12 @@ RunRecord from_json(const json& j) {
 void write_file_atomic(const std::string& path, const std::string& text) {
   const std::string tmp = temp_name(path);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw std::runtime_error(path + ": cannot write: " + errno_text());
+  if (fd < 0) throw OutputError(path + ": cannot write: " + errno_text());
   auto fail = [&](const char* what) {
     const std::string why = errno_text();
     ::close(fd);
     ::unlink(tmp.c_str());
-    throw std::runtime_error(path + ": " + what + ": " + why);
+    throw OutputError(path + ": " + what + ": " + why);
   };
   const char* p = text.data();
   size_t left = text.size();
@@ -310,12 +313,12 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   if (::close(fd) != 0) {
     const std::string why = errno_text();
     ::unlink(tmp.c_str());
-    throw std::runtime_error(path + ": cannot close: " + why);
+    throw OutputError(path + ": cannot close: " + why);
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const std::string why = errno_text();
     ::unlink(tmp.c_str());
-    throw std::runtime_error(path + ": cannot rename " + tmp + ": " + why);
+    throw OutputError(path + ": cannot rename " + tmp + ": " + why);
   }
 }
 
@@ -341,7 +344,7 @@ const std::vector<std::string>& trajectory_columns() {
 
 CsvTrajectoryWriter::CsvTrajectoryWriter(std::string path) : path_(std::move(path)), tmp_(temp_name(path_)) {
   f_ = std::fopen(tmp_.c_str(), "wb");
-  if (!f_) throw std::runtime_error(path_ + ": cannot write: " + errno_text());
+  if (!f_) throw OutputError(path_ + ": cannot write: " + errno_text());
   buffer_.resize(1 << 20);
   std::setvbuf(f_, buffer_.data(), _IOFBF, buffer_.size());
   if (std::fputs(trajectory_csv_header().c_str(), f_) == EOF) fail("cannot write");
@@ -359,7 +362,7 @@ void CsvTrajectoryWriter::fail(const std::string& what) {
   if (f_) std::fclose(f_);
   f_ = nullptr;
   std::remove(tmp_.c_str());
-  throw std::runtime_error(path_ + ": " + what + ": " + why);
+  throw OutputError(path_ + ": " + what + ": " + why);
 }
 
 size_t format_trajectory_row(const Observation& o, char* line) {
@@ -425,7 +428,7 @@ void CsvTrajectoryWriter::commit() {
   if (rc != 0 || std::rename(tmp_.c_str(), path_.c_str()) != 0) {
     const std::string why = errno_text();
     std::remove(tmp_.c_str());
-    throw std::runtime_error(path_ + ": cannot commit: " + why);
+    throw OutputError(path_ + ": cannot commit: " + why);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <istream>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -107,8 +108,15 @@ RunRecord from_json(const nlohmann::json& j);
 // json::get<long long> would convert a float such as 1e300 with undefined behaviour.
 long long json_integer(const nlohmann::json& j, const char* key);
 
+// An output that cannot be written (a path that cannot be created, a full disk, a file that
+// cannot be renamed into place): exit 2, like bad input. The message names the path and the reason.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // Writes `text` to `path.tmp.PID`, fsyncs it and renames it over `path`, so readers see the old
-// file or the new one, never a part. Throws std::runtime_error (temporary removed) on failure.
+// file or the new one, never a part. Throws OutputError (temporary removed) on failure.
 void write_file_atomic(const std::string& path, const std::string& text);
 // A whole file's bytes; throws std::runtime_error "PATH: cannot read: reason" (a directory
 // included). The file readers turn it into their own error type.

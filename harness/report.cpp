@@ -1,8 +1,6 @@
 // Comparison reports from records alone: Markdown for terminals and CI logs, a self-contained HTML page, gnuplot SVG plots.
 #include "report.h"
 
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +11,7 @@
 #include <sstream>
 
 #include "compare.h"
+#include "gnuplot.h"
 #include "records.h"
 
 namespace tippe {
@@ -305,21 +304,9 @@ struct Series {
   std::string name;  // reference or engine
   std::string title, colour;
   bool reference = false;
-  std::string file;  // plot-NAME.dat
+  std::string file;  // plot-N.dat: numbered, so that no name read from a record becomes a path
   std::map<std::string, int> block;  // quantity -> gnuplot index; absent: no finite point
 };
-
-std::string gp_quote(const std::string& s) {
-  std::string out = "'";
-  for (char ch : s) out += ch == '\'' ? std::string("''") : std::string(1, ch);
-  return out + "'";
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-  return out + "'";
-}
 
 // Writes one run's decimated series as gnuplot data blocks.
 void write_plot_data(const fs::path& dir, Series& series, Trajectory tr, const json& summary, const json& scene) {
@@ -343,7 +330,9 @@ void write_plot_data(const fs::path& dir, Series& series, Trajectory tr, const j
       {"jellett", {tr.t, scaled(tr.jellett, std::abs(J0) > 1e-300 ? J0 : 1.0)}},
       {"normal_force", {tr.t, scaled(tr.normal_force, Mg)}},
   };
-  std::string text = "# " + series.title + ": decimated series for plots.gp, one block per quantity\n";
+  // Each block opens with its title, read by plots.gp as `title columnheader(1)`: the script
+  // itself never holds a name read from a record.
+  std::string text = "# decimated series for plots.gp, one block per quantity\n";
   int index = 0;
   for (const auto& [name, xy] : quantities) {
     const auto& [x, y] = xy;
@@ -364,7 +353,7 @@ void write_plot_data(const fs::path& dir, Series& series, Trajectory tr, const j
       block += line;
     }
     if (block.empty()) continue;
-    text += "# " + name + "\n" + block + "\n\n";
+    text += "# " + name + "\n" + gp_column_header(series.title) + "\n" + block + "\n\n";
     series.block[name] = index++;
   }
   write_file_atomic((dir / series.file).string(), text);
@@ -379,7 +368,7 @@ const std::vector<PlotSpec>& plot_specs() {
       {"theta.svg", "theta", "tilt θ(t)", "t", "θ (rad)"},
       {"energy.svg", "energy", "energy E(t)/E0", "t", "E / E0"},
       {"contact_path.svg", "path", "floor contact path", "x_C", "y_C"},
-      {"jellett.svg", "jellett", "Jellett's integral J(t)/J0", "t", "J / J0"},
+      {"jellett.svg", "jellett", "Jellett integral J(t)/J0", "t", "J / J0"},
       {"normal_force.svg", "normal_force", "normal force F_n(t)/(M g)", "t", "F_n / (M g)"},
   };
   return specs;
@@ -387,7 +376,6 @@ const std::vector<PlotSpec>& plot_specs() {
 
 std::string gnuplot_script(const std::vector<Series>& series, const json& comparison) {
   const json& ref = comparison.at("reference").at("summary");
-  const std::string scene = str(comparison, "scene_name");
   std::string s =
       "# Plots of the comparison in this directory (written by tippe; regenerate with `tippe report DIR`).\n"
       "set encoding utf8\n"
@@ -401,13 +389,14 @@ std::string gnuplot_script(const std::vector<Series>& series, const json& compar
       auto it = sr.block.find(p.quantity);
       if (it == sr.block.end()) continue;
       plot += plot.empty() ? "plot " : ", \\\n     ";
-      plot += gp_quote(sr.file) + " index " + std::to_string(it->second) + " using 1:2 with lines lw " +
-              (sr.reference ? "4" : "1.5") + " lc rgb " + gp_quote(sr.colour) + " title " + gp_quote(sr.title);
+      plot += gp_literal(sr.file) + " index " + std::to_string(it->second) + " using 1:2 with lines lw " +
+              (sr.reference ? "4" : "1.5") + " lc rgb " + gp_literal(sr.colour) + " title columnheader(1)";
     }
     if (plot.empty()) continue;
-    s += "\nset output " + gp_quote(p.file) + "\n";
-    s += "set title " + gp_quote(scene + ": " + p.title) + "\n";
-    s += "set xlabel " + gp_quote(p.xlabel) + "\nset ylabel " + gp_quote(p.ylabel) + "\n";
+    // The page names the scene above every plot; the plot's own title is the program's.
+    s += "\nset output " + gp_literal(p.file) + "\n";
+    s += "set title " + gp_literal(p.title) + "\n";
+    s += "set xlabel " + gp_literal(p.xlabel) + "\nset ylabel " + gp_literal(p.ylabel) + "\n";
     const bool marks = p.quantity != "path";
     if (p.quantity == "path") s += "set size ratio -1\n";
     if (marks && has_number(ref, "inversion_time"))
@@ -419,8 +408,6 @@ std::string gnuplot_script(const std::vector<Series>& series, const json& compar
   }
   return s;
 }
-
-bool executable(const std::string& path) { return ::access(path.c_str(), X_OK) == 0 && !fs::is_directory(path); }
 
 }  // namespace
 
@@ -640,24 +627,6 @@ footer { margin-top: 2em; font-size: 0.85em; color: #555; border-top: 1px solid 
   return h;
 }
 
-std::string gnuplot_command(std::string* why_not) {
-  auto say = [&](const std::string& why) {
-    if (why_not) *why_not = why;
-    return std::string();
-  };
-  if (const char* env = std::getenv("TIPPE_GNUPLOT"); env && *env) {
-    if (std::string(env) == "none") return say("plots skipped: disabled by TIPPE_GNUPLOT=none");
-    return env;
-  }
-  const char* path = std::getenv("PATH");
-  std::istringstream dirs(path ? path : "");
-  for (std::string dir; std::getline(dirs, dir, ':');) {
-    const std::string candidate = (dir.empty() ? std::string(".") : dir) + "/gnuplot";
-    if (executable(candidate)) return candidate;
-  }
-  return say("plots skipped: gnuplot not found");
-}
-
 PlotSet render_plots(const std::string& out_dir, const json& c) {
   PlotSet result;
   std::string why;
@@ -677,7 +646,7 @@ PlotSet render_plots(const std::string& out_dir, const json& c) {
     s.reference = reference;
     s.title = reference ? "reference (" + engine + ")" : engine;
     s.colour = reference ? "#000000" : engine_colour(engine, index);
-    s.file = "plot-" + name + ".dat";
+    s.file = "plot-" + std::to_string(series.size() + missing.size()) + ".dat";
     try {
       write_plot_data(dir, s, Trajectory::from_csv(read_trajectory_csv(csv.string())), summary, c.at("scene"));
       series.push_back(s);
@@ -697,10 +666,8 @@ PlotSet render_plots(const std::string& out_dir, const json& c) {
   }
 
   write_file_atomic((dir / "plots.gp").string(), gnuplot_script(series, c));
-  const std::string cmd = "cd " + shell_quote(dir.string()) + " && " + gnuplot + " plots.gp > plots.log 2>&1";
-  const int rc = std::system(cmd.c_str());
-  if (rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0) {
-    const int code = rc != -1 && WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  const int code = run_gnuplot(gnuplot, dir, "plots.gp", "plots.log");
+  if (code != 0) {
     result.note = code == 127 ? "plots skipped: gnuplot not found (" + gnuplot + ")"
                               : "plots failed: gnuplot exited with status " + std::to_string(code) + " (see plots.log)";
     return result;

@@ -34,10 +34,6 @@ std::string render_html(const nlohmann::json& comparison, const std::vector<std:
 const std::vector<std::string>& plot_file_names();
 std::string plot_caption(const std::string& file);
 
-// The command that runs gnuplot: $TIPPE_GNUPLOT when set ("none" disables plots), else gnuplot
-// found on PATH. Empty when there is none; `why_not` then says why, as the page should.
-std::string gnuplot_command(std::string* why_not = nullptr);
-
 struct PlotSet {
   std::vector<std::string> files;  // non-empty SVGs written, relative to out_dir
   std::string note;                // "" when every plot was made

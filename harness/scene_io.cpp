@@ -165,9 +165,9 @@ class Interpreter {
     keys(root, "", {"name", "description", "gravity", "body", "contact", "initial", "run", "engines"});
     const auto name = opt_string(root, "", "name");
     s.name = name.value_or(default_name);
-    if (!is_name(s.name))
-      fail("name", "\"" + s.name + "\"" + (name ? "" : " (the file's stem)") +
-                       " is not a usable name (letters, digits, '.', '_', '-'; it names output directories)");
+    if (!is_valid_name(s.name))
+      fail("name", "\"" + s.name + "\"" + (name ? "" : " (the file's stem)") + " is not a usable name (" + kNameRule +
+                       "; it names output directories)");
     s.description = opt_string(root, "", "description").value_or("");
     if (s.description.find_first_of("\r\n") != std::string::npos) fail("description", "must be one line");
     s.gravity = need_number(root, "", "gravity");
@@ -183,13 +183,6 @@ class Interpreter {
   }
 
  private:
-  static bool is_name(const std::string& n) {
-    return !n.empty() && n != "." && n != ".." && std::all_of(n.begin(), n.end(), [](char c) {
-      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
-             c == '-' || c == '.';
-    });
-  }
-
   void keys(const toml::table& t, const std::string& prefix, std::initializer_list<const char*> allowed) const {
     for (auto&& [k, v] : t) {
       (void)v;
@@ -476,6 +469,15 @@ class Interpreter {
 };
 
 }  // namespace
+
+const char* const kNameRule = "letters, digits, '.', '_', '-'";
+
+bool is_valid_name(const std::string& n) {
+  return !n.empty() && n != "." && n != ".." && std::all_of(n.begin(), n.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+           c == '.';
+  });
+}
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
   std::string text;

@@ -63,6 +63,13 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
 Scene parse_scene_text(const std::string& text, const std::string& file_label,
                        const std::vector<std::string>& overrides = {});
 
+// The rule for every name that becomes part of a file name or a report (scene, setup, check and
+// engine names, in input files and in records read back): letters, digits, '.', '_', '-', not
+// empty, not "." or "..". No such name can hold a path separator, a quote or a newline.
+bool is_valid_name(const std::string& name);
+// What a message says a name must be ("letters, digits, '.', '_', '-'").
+extern const char* const kNameRule;
+
 // Every field of a scene, its mass properties and engine tables, for run records.
 nlohmann::json scene_to_json(const Scene& scene);
 

@@ -29,7 +29,8 @@
 #include <thread>
 
 #include "classify.h"
-#include "dir_lock.h"
+#include "interrupt.h"
+#include "output_dir.h"
 #include "provenance.h"
 #include "records.h"
 #include "scene_io.h"
@@ -59,13 +60,6 @@ std::string trim(const std::string& s) {
   if (b == std::string::npos) return {};
   const auto e = s.find_last_not_of(" \t");
   return s.substr(b, e - b + 1);
-}
-
-bool is_name(const std::string& n) {
-  return !n.empty() && n != "." && n != ".." && std::all_of(n.begin(), n.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
-           c == '.';
-  });
 }
 
 std::string idx(const std::string& key, size_t i) { return key + "[" + std::to_string(i) + "]"; }
@@ -199,7 +193,7 @@ class SweepReader {
       const toml::node* name = t.get("name");
       if (!name) fail(key + ".name", "missing (required)");
       u.name = string(*name, key + ".name");
-      if (!is_name(u.name))
+      if (!is_valid_name(u.name))
         fail(key + ".name", "\"" + u.name + "\" is not a usable name (letters, digits, '.', '_', '-')");
       if (auto [it, fresh] = names.emplace(u.name, i); !fresh)
         fail(key + ".name", "\"" + u.name + "\" is already the name of " + idx("setup", it->second));
@@ -496,6 +490,12 @@ SweepRecord sweep_record_from_json(const json& j) {
   r.scene_index = j.at("scene_index").get<long long>();
   r.setup = j.at("setup").get<std::string>();
   r.engine = j.at("engine").get<std::string>();
+  // Names read back become file names and report labels: the rule of names in input files.
+  for (const auto& [key, name] : {std::pair<const char*, const std::string*>{"scene", &r.scene},
+                                  {"setup", &r.setup},
+                                  {"engine", &r.engine}})
+    if (!is_valid_name(*name))
+      throw std::invalid_argument(std::string(key) + ": \"" + *name + "\" is not a usable name (" + kNameRule + ")");
   r.set = j.at("set").get<std::vector<std::string>>();
   r.ladder_key = j.at("ladder_key").get<std::string>();
   r.ladder_value = get_number(j, "ladder_value");
@@ -577,10 +577,23 @@ RecordsFile read_records(const std::string& path) {
     try {
       f.records.push_back(sweep_record_from_json(json::parse(l)));
     } catch (const std::exception& e) {
-      throw std::runtime_error(path + ":" + std::to_string(line) + ": not a sweep record: " + e.what());
+      // Records are input too (shared, downloaded, edited): a bad one is bad input, not a bug.
+      throw SweepInputError(path + ":" + std::to_string(line) + ": not a sweep record: " + e.what());
     }
   }
   return f;
+}
+
+fs::path keep_aside(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) return {};
+  for (int k = 1;; ++k) {
+    const fs::path to = file.string() + ".old" + (k == 1 ? std::string() : "." + std::to_string(k));
+    if (fs::exists(to, ec)) continue;
+    fs::rename(file, to, ec);
+    if (ec) throw std::runtime_error(file.string() + ": cannot keep it aside as " + to.string() + ": " + ec.message());
+    return to;
+  }
 }
 
 RecordsFile recover_records(const std::string& path) {
@@ -716,6 +729,8 @@ SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Referenc
     try {
       sim = make_simulator(setup.engine, p.scene);
       run = run_simulator(*sim, p.scene, k == 0 ? &sink : nullptr);
+    } catch (const Interrupted&) {
+      throw;  // a signal is not a result of the point
     } catch (...) {
       // An engine that refuses the scene or throws mid-run is a failed point, not a failed sweep.
       run = RunRecord{};
@@ -1022,7 +1037,7 @@ Prepared decode(const std::string& bytes) {
 
 // The coordinator's half of the start: checks OUT, takes its lock, recovers records.jsonl and
 // decides what runs. Throws SweepInputError before anything is written.
-Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<DirLock>& lock,
+Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<OutputDir>& lock,
                  std::vector<Reference>& refs) {
   if (o.jobs < 1) throw SweepInputError("jobs must be at least 1, got " + std::to_string(o.jobs));
   if (o.out_dir.empty()) throw SweepInputError("no output directory");
@@ -1070,13 +1085,10 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<D
                           "; give --restart to begin the directory again, or another --out");
   }
 
-  std::error_code mk;
-  fs::create_directories(out, mk);
-  if (mk) throw SweepInputError(out.string() + ": cannot create the output directory: " + mk.message());
-  lock = std::make_unique<DirLock>(out);
+  lock = std::make_unique<OutputDir>(out);
   if (fresh || o.restart) {
     // Beginning again: earlier records are kept aside, never silently mixed with the new ones.
-    if (fs::exists(records_file, ec)) fs::rename(records_file, out / "records.jsonl.old");
+    keep_aside(records_file);
     write_file_atomic(sweep_file.string(), sweep_json(plan, shard).dump(2) + "\n");
   }
 
@@ -1138,6 +1150,9 @@ std::string from_coordinator(TaskFarm& farm, const std::function<std::string()>&
     try {
       message = "ok\n" + make();
     } catch (const SweepInputError& e) {
+      message = std::string("input\n") + e.what();
+    } catch (const OutputError& e) {
+      // An output directory that cannot be used (held by another tippe, not creatable) is bad input too.
       message = std::string("input\n") + e.what();
     } catch (const std::exception& e) {
       message = std::string("error\n") + e.what();
@@ -1201,7 +1216,7 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
   std::vector<Reference> refs(plan.scenes.size());
 
   // 1. The coordinator decides; its decision (or its refusal) reaches every rank.
-  std::unique_ptr<DirLock> lock;
+  std::unique_ptr<OutputDir> lock;
   Prepared prep;
   const std::string decision = from_coordinator(farm, [&] {
     prep = prepare(plan, o, lock, refs);
@@ -1290,7 +1305,13 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
   outcome.ran = prep.todo.size();
   outcome.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  if (farm.coordinator()) write_sweep_report(out.string(), read_records(records_file.string()).records, o.plots);
+  if (farm.coordinator()) {
+    // The report's files change as one unit: an interrupted rerun of a finished sweep leaves the old report.
+    const InterruptGuard guard;
+    const std::vector<SweepRecord> records = read_records(records_file.string()).records;
+    write_sweep_report(lock->stage(true).string(), records, o.plots);
+    lock->commit();
+  }
   return outcome;
 }
 

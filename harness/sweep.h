@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -140,11 +141,17 @@ struct RecordsFile {
   size_t complete_bytes = 0;         // bytes of the complete lines
   size_t partial_bytes = 0;          // a last line without '\n' (a write cut short), dropped
 };
-// Reads records.jsonl (a missing file is empty). A complete line that is not a record throws
-// std::runtime_error "FILE:LINE: reason"; a partial last line is only measured.
+
+// Reads records.jsonl (a missing file is empty). A complete line that is not a record (records
+// are input: a name breaking is_valid_name included) throws SweepInputError "FILE:LINE: reason";
+// a partial last line is only measured.
 RecordsFile read_records(const std::string& path);
 // read_records, then truncates the file to its complete lines (fsynced) when the last is partial.
 RecordsFile recover_records(const std::string& path);
+// Renames `file`, when it exists, to the first free name of FILE.old, FILE.old.2, FILE.old.3, ...
+// (--restart keeps every earlier record file, never one over another). Returns the new name, or ""
+// when there was no file. Throws std::runtime_error naming the file when the rename fails.
+std::filesystem::path keep_aside(const std::filesystem::path& file);
 
 // ---- running ----------------------------------------------------------------------------------
 

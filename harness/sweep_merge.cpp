@@ -7,7 +7,8 @@
 #include <sstream>
 #include <tuple>
 
-#include "dir_lock.h"
+#include "interrupt.h"
+#include "output_dir.h"
 #include "provenance.h"
 #include "records.h"
 #include "sweep.h"
@@ -167,10 +168,12 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
     refuse(records_file.string() + ": records without " + meta_file.string() +
            "; give another --out, or --restart to begin it again");
   }
-  fs::create_directories(out, ec);
-  if (ec) refuse(out.string() + ": cannot create the output directory: " + ec.message());
-  DirLock lock(out);
-  if (restart && fs::exists(records_file, ec)) fs::rename(records_file, out / "records.jsonl.old");
+  // The merged directory is written as one unit beside the old one and swapped in at the end.
+  const InterruptGuard guard;
+  OutputDir lock(out);
+  const fs::path stage = lock.stage(true);
+  const fs::path staged_meta = stage / meta_file.filename(), staged_records = stage / records_file.filename();
+  if (restart) keep_aside(staged_records);
 
   json meta = first.meta;
   meta["shard"] = nullptr;
@@ -179,14 +182,14 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
     from.push_back({{"dir", s->dir.string()}, {"index", i}, {"provenance", s->meta.value("provenance", json())}});
   meta["merged_from"] = from;
   meta["provenance"] = to_json(current_provenance());
-  write_file_atomic(meta_file.string(), meta.dump(2) + "\n");
+  write_file_atomic(staged_meta.string(), meta.dump(2) + "\n");
 
   // The references, so that a later `tippe sweep SWEEP --out DIR` finds them cached.
   for (const auto& [i, s] : by_index) {
     const fs::path refs = s->dir / "reference";
     if (!fs::is_directory(refs, ec)) continue;
     for (const auto& entry : fs::directory_iterator(refs, ec)) {
-      const fs::path src = entry.path(), dst = out / "reference" / src.filename();
+      const fs::path src = entry.path(), dst = stage / "reference" / src.filename();
       if (!entry.is_directory() || fs::exists(dst / "summary.json", ec) || !fs::exists(src / "summary.json", ec))
         continue;
       fs::create_directories(dst);
@@ -201,8 +204,9 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
     text += to_jsonl(*r);
     records.push_back(*r);
   }
-  write_file_atomic(records_file.string(), text);
-  write_sweep_report(out.string(), records, plots);
+  write_file_atomic(staged_records.string(), text);
+  write_sweep_report(stage.string(), records, plots);
+  lock.commit();
   outcome.shards = shards.size();
   outcome.points = records.size();
   return outcome;

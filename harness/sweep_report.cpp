@@ -1,5 +1,4 @@
 // Analysis of sweep records (convergence orders, cheapest settings, regimes) and the report made from them alone.
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +14,7 @@
 #include <tuple>
 #include <vector>
 
+#include "gnuplot.h"
 #include "records.h"
 #include "report.h"
 #include "sweep.h"
@@ -426,18 +426,6 @@ std::vector<Chart> make_charts(const SceneGroup& s) {
   return charts;
 }
 
-std::string gp_quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 // Writes the data and one gnuplot script for every chart with data, runs gnuplot, and returns
 // the SVGs that came out; `note` says what is missing.
 std::vector<std::string> render_charts(const fs::path& dir, const std::vector<Chart>& charts, std::string& note) {
@@ -465,16 +453,17 @@ std::vector<std::string> render_charts(const fs::path& dir, const std::vector<Ch
     std::ostringstream d;
     d.precision(17);
     for (size_t i = 0; i < nonempty.size(); ++i) {
-      d << "# " << nonempty[i]->title << "\n";
+      // The title is data (`title columnheader(1)` below): no name reaches the script.
+      d << gp_column_header(nonempty[i]->title) << "\n";
       for (const auto& [x, y] : nonempty[i]->xy) d << x << " " << y << "\n";
       d << "\n\n";
     }
     write_file_atomic((dir / dat).string(), d.str());
-    gp << "\nset output " << gp_quote(c.file) << "\n";
+    gp << "\nset output " << gp_literal(c.file) << "\n";
     gp << (c.logy ? "set logscale y\nset format y '%g'\nset autoscale y\n"
                   : "unset logscale y\nset format y '%g'\nset yrange [0:" + fmt("%.17g", 1.08 * c.hline.value_or(1.0)) +
                         "]\n");
-    gp << "set ylabel " << gp_quote(c.ylabel) << "\nset title " << gp_quote(c.title) << "\n";
+    gp << "set ylabel " << gp_literal(c.ylabel) << "\nset title " << gp_literal(c.title) << "\n";
     gp << (c.hline ? "set arrow 1 from graph 0, first " + fmt("%.17g", *c.hline) + " to graph 1, first " +
                          fmt("%.17g", *c.hline) + " nohead dt 2 lc rgb '#555555'\n"
                    : std::string("unset arrow 1\n"));
@@ -483,13 +472,13 @@ std::vector<std::string> render_charts(const fs::path& dir, const std::vector<Ch
       const Series& s = *nonempty[i];
       if (i) gp << ", \\\n     ";
       if (s.engine.empty()) {
-        gp << gp_quote(dat) << " index " << i << " using 1:2 with points pt 2 ps 1.5 lc rgb '#000000' title "
-           << gp_quote(s.title);
+        gp << gp_literal(dat) << " index " << i
+           << " using 1:2 with points pt 2 ps 1.5 lc rgb '#000000' title columnheader(1)";
       } else {
         const bool analytic = s.engine == "analytic";
-        gp << gp_quote(dat) << " index " << i << " using 1:2 with linespoints lw " << (analytic ? 2.5 : 1.5) << " dt "
-           << (1 + s.variant % 5) << " pt " << (analytic ? 5 : 7 + 2 * (s.variant % 4)) << " ps 0.9 lc rgb '"
-           << engine_colour(s.engine) << "' title " << gp_quote(s.title);
+        gp << gp_literal(dat) << " index " << i << " using 1:2 with linespoints lw " << (analytic ? 2.5 : 1.5)
+           << " dt " << (1 + s.variant % 5) << " pt " << (analytic ? 5 : 7 + 2 * (s.variant % 4)) << " ps 0.9 lc rgb "
+           << gp_literal(engine_colour(s.engine)) << " title columnheader(1)";
       }
     }
     gp << "\n";
@@ -500,9 +489,7 @@ std::vector<std::string> render_charts(const fs::path& dir, const std::vector<Ch
     return made;
   }
   write_file_atomic((dir / "sweep-plots.gp").string(), gp.str());
-  const std::string cmd =
-      "cd " + shell_quote(dir.string()) + " && " + gnuplot + " sweep-plots.gp > sweep-plots.log 2>&1";
-  const int rc = std::system(cmd.c_str());
+  const int code = run_gnuplot(gnuplot, dir, "sweep-plots.gp", "sweep-plots.log");
   std::vector<std::string> missing;
   for (const std::string& f : planned) {
     std::error_code ec;
@@ -511,9 +498,8 @@ std::vector<std::string> render_charts(const fs::path& dir, const std::vector<Ch
     else
       missing.push_back(f);
   }
-  if (rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0 || !missing.empty())
-    note = "some plots failed (gnuplot exit " + std::to_string(rc != -1 && WIFEXITED(rc) ? WEXITSTATUS(rc) : -1) +
-           "; see sweep-plots.log)";
+  if (code != 0 || !missing.empty())
+    note = "some plots failed (gnuplot exit " + std::to_string(code) + "; see sweep-plots.log)";
   return made;
 }
 

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "compare.h"
+#include "gnuplot.h"
 #include "records.h"
 #include "report.h"
 #include "scene_io.h"

@@ -163,7 +163,7 @@ TEST(SweepRecords, ACorruptCompleteLineNamesFileAndLine) {
   try {
     read_records(file.string());
     FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
+  } catch (const SweepInputError& e) {
     EXPECT_NE(std::string(e.what()).find(file.string() + ":2:"), std::string::npos) << e.what();
   }
 }
@@ -523,6 +523,13 @@ TEST(SweepCli, ChangedSweepFileIsRefusedUnlessRestarted) {
   ASSERT_EQ(e.code, 0) << slurp(err);
   EXPECT_EQ(count_lines(out / "records.jsonl"), 2u);
   EXPECT_TRUE(fs::exists(out / "records.jsonl.old")) << "earlier records are kept aside";
+
+  // A second restart keeps the first set aside too, under the next free name.
+  const std::string first_old = slurp(out / "records.jsonl.old");
+  e = run_tippe({"sweep", sweep.string(), "--out", out.string(), "--restart", "--no-plots"}, err);
+  ASSERT_EQ(e.code, 0) << slurp(err);
+  EXPECT_EQ(slurp(out / "records.jsonl.old"), first_old) << "--restart keeps every earlier record file";
+  EXPECT_EQ(count_lines(out / "records.jsonl.old.2"), 2u);
 }
 
 TEST(SweepCli, InvalidSweepExitsWithTwoAndWritesNothing) {
