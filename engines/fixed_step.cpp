@@ -60,13 +60,15 @@ void FixedStepSimulator::advance_to(double t) {
 void FixedStepSimulator::step_once() {
   const BodyState x = engine_state();
   if (scene_.contact.friction == FrictionLaw::Viscous) {
-    // The source's law F_t = -k v_C at the geometric contact point, while the engine has a
-    // contact: the engine's own contact is frictionless in this mode.
+    // The source's law F_t = -k v_C at every contact the engine has, each at its own geometric
+    // contact point with its own velocity (the engine's own contact is frictionless in this
+    // mode). With ball and stem both down, friction at one of them only would let the other
+    // slide freely: the reference applies the law at each contact, so the engines must too.
     const ContactReport c = engine_contacts();
-    if (c.ball || c.stem) {
-      const Surface s = lower_surface(body_, x.q_WB);
+    const Vec3 w_W = x.q_WB * x.w_B;
+    for (const Surface s : {Surface::Ball, Surface::Stem}) {
+      if (!(s == Surface::Ball ? c.ball : c.stem && body_.stem)) continue;
       const Vec3 R_C = contact_offset_W(body_, x.q_WB, s);
-      const Vec3 w_W = x.q_WB * x.w_B;
       Vec3 v_C = x.v_WG + w_W.cross(R_C);
       v_C.z() = 0.0;
       apply_force_W(-scene_.contact.k * v_C, x.p_WG + R_C);
