@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "simulator.h"
 
@@ -15,6 +16,10 @@ std::unique_ptr<Simulator> make_mujoco_simulator(const Scene& scene);
 
 // The MJCF text of a scene's MuJoCo model (what `tippe export-mjcf` writes).
 std::string mujoco_mjcf(const Scene& scene);
+// What a scene's physics has that the MJCF of mujoco_mjcf does not carry (a law the bench applies
+// itself each step, such as viscous friction), one sentence each; empty when the file alone is
+// the scene.
+std::vector<std::string> mujoco_mjcf_missing(const Scene& scene);
 
 // Each throws std::invalid_argument naming the key when the scene's [engines.NAME] table has
 // an unknown key, a wrong type or a value out of range.

@@ -8,7 +8,7 @@
 namespace tippe {
 
 // The top body's mass properties as the compiled mjModel stores them: body_mass, body_ipos
-// (centre of mass in the body frame, whose origin is G), body_inertia (principal moments) and
+// (centre of mass in the body frame, whose origin is G or the ball centre O: engines.mujoco.body_frame), body_inertia (principal moments) and
 // body_iquat (principal axes in the body frame).
 struct MujocoModelReadback {
   double mass = 0.0;

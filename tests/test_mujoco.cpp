@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <memory>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -168,9 +169,8 @@ TEST(Mujoco, SettingsErrorsNameTheKey) {
   }
   {
     Scene s = dimensionless_scene();
-    // Below MuJoCo's stability rule timeconst >= 2 timestep (2e-4 at the default step).
-    s.engines["mujoco"]["solref"] = std::vector<double>{1e-4, 1.0};
-    expect_setting_error(s, "solref");
+    s.engines["mujoco"]["body_frame"] = std::string("origin");  // not one of the choices
+    expect_setting_error(s, "body_frame");
   }
   {
     Scene s = dimensionless_scene();
@@ -372,6 +372,108 @@ TEST(Mujoco, ExportedMjcfAloneReproducesTheRun) {
   // Same model, same keyframe, same steps: bit for bit, no tolerance.
   for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(bit_equal(a[i], qpos[i])) << "qpos " << i << ": " << a[i] << " vs " << qpos[i];
   for (size_t i = 0; i < b.size(); ++i) EXPECT_TRUE(bit_equal(b[i], qvel[i])) << "qvel " << i << ": " << b[i] << " vs " << qvel[i];
+}
+
+// solref below MuJoCo's stability rule (timeconst >= 2 timestep) is accepted as MuJoCo accepts
+// it: MuJoCo raises it (refsafe), and the run says so and records the value used.
+TEST(Mujoco, SolrefBelowTwoStepsIsRaisedAsMujocoDoes) {
+  Scene s = dimensionless_scene();
+  s.engines["mujoco"]["solref"] = std::vector<double>{1e-4, 1.0};
+  const auto sim = make_mujoco_simulator(s);
+  EXPECT_EQ(setting_value(sim->settings(), "solref"), "[0.0001, 1]");
+  EXPECT_EQ(setting_value(sim->settings(), "solref_used"), "[0.00020000000000000001, 1]");
+  bool noted = false;
+  for (const auto& n : sim->notes()) noted = noted || n.find("raised by MuJoCo") != std::string::npos;
+  EXPECT_TRUE(noted);
+  // Raised, it is the same model as solref = 2 timestep: the same run bit for bit.
+  Scene t = dimensionless_scene();
+  t.engines["mujoco"]["solref"] = std::vector<double>{2e-4, 1.0};
+  const auto twin = make_mujoco_simulator(t);
+  sim->advance_to(0.2);
+  twin->advance_to(0.2);
+  EXPECT_TRUE(bit_equal(sim->observe().state, twin->observe().state));
+}
+
+Scene with_frame(Scene s, const std::string& frame) {
+  s.engines["mujoco"]["body_frame"] = frame;
+  return s;
+}
+
+// With the frame at the ball's centre O the model holds the same body: the centre of mass at
+// -d e_Z in the body frame, the same moments, and the same state of G at the start.
+TEST(Mujoco, BallCentreFrameHoldsTheSameBodyAndStart) {
+  const Scene scene = with_frame(dimensionless_scene(), "ball_centre");
+  const auto sim = make_mujoco_simulator(scene);
+  const MujocoModelReadback r = mujoco_model_readback(*sim);
+  // 1e-12: as MassReadBackEqualsScene (17-digit decimals through MuJoCo's compiler).
+  EXPECT_NEAR(r.ipos_B.z(), -scene.mass.com_offset, 1e-12);
+  EXPECT_NEAR(std::hypot(r.ipos_B.x(), r.ipos_B.y()), 0.0, 1e-12);
+  EXPECT_NEAR(r.inertia.z(), scene.mass.inertia_axial, 1e-12);
+  const BodyState x0 = scene_initial_state(scene), y = sim->observe().state;
+  // 1e-14 as InitialStateMatchesScene, plus the frame change's own rounding (d w of unit size).
+  EXPECT_LE((y.p_WG - x0.p_WG).norm(), 1e-14);
+  EXPECT_LE((y.v_WG - x0.v_WG).norm(), 1e-13);
+  EXPECT_LE((y.w_B - x0.w_B).norm(), 1e-14);
+}
+
+// In free flight (no contact) a rigid body's motion does not depend on where its frame is: both
+// frames give the same trajectory of G to the integrator's error. This tests the conversion of
+// qpos/qvel to G and back; RK4 at 1e-4 over 1 time unit of a spin of 5: error ~ (w h)^4 ~ 1e-13
+// per step, 1e-9 after 1e4 steps.
+TEST(Mujoco, FrameDoesNotChangeFreeFlight) {
+  Scene s = dimensionless_scene();
+  s.contact.flight = true;
+  s.initial.height = 1.0;
+  s.gravity = 1.0;
+  const auto a = make_mujoco_simulator(with_frame(s, "com"));
+  const auto b = make_mujoco_simulator(with_frame(s, "ball_centre"));
+  a->advance_to(1.0);
+  b->advance_to(1.0);
+  const BodyState x = a->observe().state, y = b->observe().state;
+  EXPECT_LE((x.p_WG - y.p_WG).norm(), 1e-9);
+  EXPECT_LE((x.v_WG - y.v_WG).norm(), 1e-9);
+  EXPECT_LE(x.q_WB.angularDistance(y.q_WB), 1e-9);
+  EXPECT_LE((x.w_B - y.w_B).norm(), 1e-9);
+}
+
+// On the floor it does (BENCHMARKS.md, "MuJoCo's body frame"): the setting must reach the model.
+// After 0.5 time units of the sliding dimensionless top the two frames part by far more than the
+// free-flight agreement above.
+TEST(Mujoco, FrameChangesTheContactRun) {
+  const Scene s = dimensionless_scene();
+  const auto a = make_mujoco_simulator(with_frame(s, "com"));
+  const auto b = make_mujoco_simulator(with_frame(s, "ball_centre"));
+  a->advance_to(2.0);
+  b->advance_to(2.0);
+  const BodyState x = a->observe().state, y = b->observe().state;
+  EXPECT_GT((x.p_WG - y.p_WG).norm() + (x.w_B - y.w_B).norm(), 1e-6);
+  EXPECT_NE(setting_value(a->settings(), "body_frame"), setting_value(b->settings(), "body_frame"));
+}
+
+// The exported model of a ball-centre frame, run in plain MuJoCo, is the adapter's run bit for bit.
+TEST(Mujoco, ExportedBallCentreModelReproducesTheRun) {
+  const Scene scene = with_frame(dimensionless_scene(), "ball_centre");
+  char error[1024] = "";
+  const std::string xml = mujoco_mjcf(scene);
+  // mjVFS holds 2000 names of 1000 bytes: on the heap.
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  ASSERT_EQ(mj_makeEmptyFileVFS(vfs.get(), "top.xml", static_cast<int>(xml.size())), 0);
+  std::memcpy(vfs->filedata[vfs->nfile - 1], xml.data(), xml.size());
+  mjModel* m = mj_loadXML("top.xml", vfs.get(), error, sizeof error);
+  mj_deleteVFS(vfs.get());
+  ASSERT_NE(m, nullptr) << error;
+  mjData* d = mj_makeData(m);
+  mj_resetDataKeyframe(m, d, 0);
+  for (int i = 0; i < 500; ++i) mj_step(m, d);
+  const std::vector<double> qpos(d->qpos, d->qpos + m->nq);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  const auto sim = make_mujoco_simulator(scene);
+  sim->advance_to(500 * 1e-4);
+  const std::vector<double> a = mujoco_qpos(*sim);
+  ASSERT_EQ(a.size(), qpos.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(bit_equal(a[i], qpos[i])) << "qpos " << i;
 }
 
 // Measurement, not a check: run with --gtest_also_run_disabled_tests to see whether and when
