@@ -360,6 +360,9 @@ void expect_checks(const Checks& c, const fs::path& dir, const std::string& when
     EXPECT_NE(slurp(dir / expand(p, dir)).find(expand(text, dir)), std::string::npos) << when << ": " << p << " lacks " << text;
 }
 
+// gtest shows a case by its name, not its bytes.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
 class Hostile : public ::testing::TestWithParam<Case> {};
 
 TEST_P(Hostile, Case) {
