@@ -139,7 +139,7 @@ struct SweepRecord {
 };
 nlohmann::json to_json(const SweepRecord& r);
 // Every field checked for its type and range (indices 0 <= i < kMaxSweepPoints, repeats as in a
-// sweep file, counts >= 0, times and costs numbers or null, status and class known names);
+// sweep file, counts >= 0, times and costs numbers or null, the class a known name);
 // throws SweepRecordError "KEY: reason" for anything else, another format included.
 SweepRecord sweep_record_from_json(const nlohmann::json& j);
 // One line of records.jsonl, '\n' included.

@@ -180,8 +180,8 @@ TEST(SweepRecords, FieldsReadBackAreCheckedByKey) {
   j["repeats"] = 0;
   EXPECT_EQ(message(j).rfind("repeats: 0 is out of range", 0), 0u) << message(j);
   j = to_json(sample_record());
-  j["status"] = "fine";
-  EXPECT_EQ(message(j).rfind("status: \"fine\" is not one of ok, ", 0), 0u) << message(j);
+  j["class"]["name"] = "fine";
+  EXPECT_EQ(message(j).rfind("class.name: \"fine\" is not one of ok, ", 0), 0u) << message(j);
   j = to_json(sample_record());
   j["metrics"]["steps"] = "many";
   EXPECT_EQ(message(j).rfind("metrics: ", 0), 0u) << message(j);
