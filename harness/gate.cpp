@@ -277,10 +277,12 @@ const GateMetric* find_gate_metric(const std::string& name) {
 // ---- gate files -----------------------------------------------------------------------------
 
 GateFile load_gate_file(const std::string& path) {
+  // The path names the JUnit suite and is in the JSON results: checked before anything is read.
+  if (!is_valid_utf8(path)) throw SceneError(utf8_replaced(path) + ": cannot read: the path is not valid UTF-8");
   GateReader reader(path);
   std::string text;
   try {
-    text = read_file_text(path);
+    text = read_file_text(path, kMaxInputFileBytes);
   } catch (const std::runtime_error& e) {
     throw SceneError(e.what());
   }
@@ -512,7 +514,9 @@ json number_or_null(const std::optional<double>& v) {
 
 // Text and attribute values: the five XML specials, and control characters XML 1.0 cannot
 // carry at all (an engine's status detail could hold any byte).
-std::string xml_escape(const std::string& s, bool attribute) {
+std::string xml_escape(const std::string& text, bool attribute) {
+  // A byte that is not UTF-8 would make the whole document malformed (the declaration says UTF-8).
+  const std::string s = utf8_replaced(text);
   std::string out;
   out.reserve(s.size());
   for (char ch : s) {

@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -322,15 +323,23 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   }
 }
 
-std::string read_file_text(const std::string& path) {
+std::string read_file_text(const std::string& path, size_t max_bytes) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": cannot read: is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot read: " + errno_text());
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  // Chunks up to one byte past the bound, so that an endless file (/dev/zero) stops there.
+  std::string text;
+  char buf[1 << 16];
+  while (in) {
+    in.read(buf, static_cast<std::streamsize>(std::min(sizeof buf, max_bytes + 1 - text.size())));
+    text.append(buf, static_cast<size_t>(in.gcount()));
+    if (text.size() > max_bytes)
+      throw std::runtime_error(path + ": cannot read: larger than " + std::to_string(max_bytes) +
+                               " bytes (the bound for this kind of file)");
+  }
   if (in.bad()) throw std::runtime_error(path + ": cannot read: " + errno_text());
-  return ss.str();
+  return text;
 }
 
 const std::vector<std::string>& trajectory_columns() {

@@ -26,8 +26,13 @@ namespace tippe {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-// A guard against a typo in sample_interval producing a trajectory of many gigabytes.
-constexpr double kMaxSamples = 1e8;
+// A byte budget, not a count, against a typo in sample_interval: a run's trajectory.csv is at
+// most kMaxTrajectoryBytes at the longest row (kTrajectoryRowMax), and the same bound caps what a
+// run keeps in memory (a sweep's reference holds its CSV text, ~450 bytes a row, and every
+// comparison a Trajectory, 92 bytes a row, per run). 1 GiB allows ~1.2e6 samples, 30 times the
+// longest shipped scene (extremes/long_horizon: 41900); the count it replaces, 1e8, let ~55 GB through.
+constexpr double kMaxTrajectoryBytes = 1024.0 * 1024.0 * 1024.0;
+constexpr double kMaxSamples = kMaxTrajectoryBytes / static_cast<double>(kTrajectoryRowMax);
 // Below a few machine epsilons (2.2e-16) the integrator's error estimate is rounding noise: no
 // step can meet the tolerance and the run only ends by failing.
 constexpr double kMinRtol = 1e-15;
@@ -68,33 +73,36 @@ bool is_bare_key(const std::string& s) {
   });
 }
 
-// Well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF). What
-// toml++ enforces on a document, checked here on the text that does not pass through it.
-bool is_utf8(const std::string& s) {
-  size_t i = 0;
+// Length of the well-formed UTF-8 sequence at s[i] (RFC 3629: no overlong forms, no surrogates,
+// nothing above U+10FFFF), 0 when there is none. What toml++ enforces on a document, checked here
+// on the text that does not pass through it.
+size_t utf8_sequence(const std::string& s, size_t i) {
   const size_t n = s.size();
-  while (i < n) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    size_t len;
-    unsigned lo = 0x80, hi = 0xBF;  // range of the second byte
-    if (c < 0x80) len = 1;
-    else if (c >= 0xC2 && c <= 0xDF) len = 2;
-    else if (c >= 0xE0 && c <= 0xEF) {
-      len = 3;
-      if (c == 0xE0) lo = 0xA0;
-      if (c == 0xED) hi = 0x9F;
-    } else if (c >= 0xF0 && c <= 0xF4) {
-      len = 4;
-      if (c == 0xF0) lo = 0x90;
-      if (c == 0xF4) hi = 0x8F;
-    } else return false;
-    if (n - i < len) return false;
-    for (size_t k = 1; k < len; ++k) {
-      const auto b = static_cast<unsigned char>(s[i + k]);
-      if (k == 1 ? (b < lo || b > hi) : (b < 0x80 || b > 0xBF)) return false;
-    }
-    i += len;
+  const auto c = static_cast<unsigned char>(s[i]);
+  size_t len;
+  unsigned lo = 0x80, hi = 0xBF;  // range of the second byte
+  if (c < 0x80) len = 1;
+  else if (c >= 0xC2 && c <= 0xDF) len = 2;
+  else if (c >= 0xE0 && c <= 0xEF) {
+    len = 3;
+    if (c == 0xE0) lo = 0xA0;
+    if (c == 0xED) hi = 0x9F;
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    len = 4;
+    if (c == 0xF0) lo = 0x90;
+    if (c == 0xF4) hi = 0x8F;
+  } else return 0;
+  if (n - i < len) return 0;
+  for (size_t k = 1; k < len; ++k) {
+    const auto b = static_cast<unsigned char>(s[i + k]);
+    if (k == 1 ? (b < lo || b > hi) : (b < 0x80 || b > 0xBF)) return 0;
   }
+  return len;
+}
+
+bool is_utf8(const std::string& s) {
+  for (size_t i = 0, len; i < s.size(); i += len)
+    if ((len = utf8_sequence(s, i)) == 0) return false;
   return true;
 }
 
@@ -412,11 +420,12 @@ class Interpreter {
     r.sample_interval = need_number(t, "run", "sample_interval");
     if (!(r.sample_interval > 0 && r.sample_interval <= r.duration))
       out_of_range("run.sample_interval", r.sample_interval, "0 < sample_interval <= duration = " + num(r.duration));
-    if (r.duration / r.sample_interval > kMaxSamples)
-      fail("run.sample_interval", num(r.sample_interval) + " gives " + num(r.duration / r.sample_interval) +
-                                      " samples, more than " + num(kMaxSamples) +
-                                      " (expected sample_interval >= duration / " + num(kMaxSamples) + " = " +
-                                      num(r.duration / kMaxSamples) + ")");
+    if (r.duration / r.sample_interval + 1 > kMaxSamples)
+      fail("run.sample_interval",
+           num(r.sample_interval) + " gives " + num(r.duration / r.sample_interval + 1) + " samples, up to " +
+               num(std::ceil((r.duration / r.sample_interval + 1) * kTrajectoryRowMax / 1048576.0)) +
+               " MiB of trajectory, over the budget of " + num(kMaxTrajectoryBytes / 1048576.0) +
+               " MiB (expected sample_interval >= " + num(r.duration / (std::floor(kMaxSamples) - 1)) + ")");
     r.rtol = opt_number(t, "run", "rtol").value_or(r.rtol);
     if (!(r.rtol >= kMinRtol && r.rtol <= kMaxRtol))
       out_of_range("run.rtol", r.rtol, num(kMinRtol) + " <= rtol <= " + num(kMaxRtol));
@@ -479,10 +488,28 @@ bool is_valid_name(const std::string& n) {
   });
 }
 
+bool is_valid_utf8(const std::string& s) { return is_utf8(s); }
+
+std::string utf8_replaced(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (size_t i = 0; i < s.size();) {
+    const size_t len = utf8_sequence(s, i);
+    if (len == 0) {
+      out += "\xEF\xBF\xBD";  // U+FFFD
+      ++i;
+    } else {
+      out.append(s, i, len);
+      i += len;
+    }
+  }
+  return out;
+}
+
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
   std::string text;
   try {
-    text = read_file_text(path);
+    text = read_file_text(path, kMaxInputFileBytes);
   } catch (const std::runtime_error& e) {
     throw SceneError(e.what());
   }

@@ -30,7 +30,8 @@ class SceneError : public std::runtime_error {
 // accepted for floats, booleans are not numbers):
 //  - required: gravity (> 0), body.sphere_radius, body.truncation_height (0 < h <= R),
 //    contact.friction, initial.tilt ([0, pi]), one of initial.spin / initial.omega,
-//    run.duration (> 0), run.sample_interval (> 0, <= duration, at most 1e8 samples).
+//    run.duration (> 0), run.sample_interval (> 0, <= duration, at most ~1.2e6 samples: a 1 GiB
+//    budget of trajectory bytes).
 //    body.stem_radius and body.stem_length are required unless contact.stem = false; when
 //    given they must be positive and, for every scene, pass geometry_problems(body, stem).
 //  - optional with defaults: name (file stem; letters, digits, '.', '_', '-'), description
@@ -69,6 +70,13 @@ Scene parse_scene_text(const std::string& text, const std::string& file_label,
 bool is_valid_name(const std::string& name);
 // What a message says a name must be ("letters, digits, '.', '_', '-'").
 extern const char* const kNameRule;
+
+// Whether `s` is well-formed UTF-8 (RFC 3629). Every path and name that reaches a JSON record or
+// an XML report is checked with it first: nlohmann::json throws on invalid UTF-8 while writing.
+bool is_valid_utf8(const std::string& s);
+// `s` with every byte that is not part of a well-formed UTF-8 sequence replaced by U+FFFD, for
+// text that must be shown (an XML report, a message) whatever its bytes.
+std::string utf8_replaced(const std::string& s);
 
 // Every field of a scene, its mass properties and engine tables, for run records.
 nlohmann::json scene_to_json(const Scene& scene);

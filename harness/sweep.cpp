@@ -27,6 +27,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <tuple>
 
 #include "classify.h"
 #include "interrupt.h"
@@ -185,6 +186,7 @@ class SweepReader {
     if (setups.empty()) fail("setup", "must have at least one [[setup]]");
     const std::vector<std::string> engines = available_engines();
     std::map<std::string, size_t> names;
+    size_t planned = 0;  // ladder values so far, over the setups
     for (size_t i = 0; i < setups.size(); ++i) {
       const std::string key = idx("setup", i);
       const toml::table& t = table(*setups.get(i), key);
@@ -235,6 +237,12 @@ class SweepReader {
       if (values.empty()) fail(key + ".ladder.values", "must list at least one value");
       for (size_t j = 0; j < values.size(); ++j) {
         const std::string vk = idx(key + ".ladder.values", j);
+        // The plan's size is known from the file alone: refused here, before a single point is
+        // loaded (and before the quadratic check of distinct values runs over a huge ladder).
+        if (s.scenes.size() * ++planned > kMaxSweepPoints)
+          fail(vk, std::to_string(s.scenes.size()) + " scene(s) x " + std::to_string(planned) +
+                       " ladder value(s) so far is more than " + std::to_string(kMaxSweepPoints) +
+                       " points, the most a sweep plans; split it into several sweep files");
         double v;
         const std::string vt = value_text(*values.get(j), vk, v);
         for (size_t m = 0; m < u.ladder_values.size(); ++m)
@@ -316,9 +324,11 @@ std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& se
 
 SweepPlan load_sweep(const std::string& path) {
   SweepReader reader(path);
+  // The path is in sweep.json and every record: JSON, so UTF-8, checked before anything is read.
+  if (!is_valid_utf8(path)) throw SceneError(utf8_replaced(path) + ": cannot read: the path is not valid UTF-8");
   std::string text;
   try {
-    text = read_file_text(path);
+    text = read_file_text(path, kMaxInputFileBytes);
   } catch (const std::runtime_error& e) {
     throw SceneError(e.what());
   }
@@ -403,15 +413,78 @@ namespace {
 
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 json number(const std::optional<double>& v) { return v ? number(*v) : json(nullptr); }
-double get_number(const json& j, const char* key) {
-  const json& v = j.at(key);
-  return v.is_null() ? std::nan("") : v.get<double>();
-}
-std::optional<double> get_optional(const json& j, const char* key) {
-  const json& v = j.at(key);
-  if (v.is_null()) return std::nullopt;
-  return v.get<double>();
-}
+
+// A record read back is input like any file: every field is checked for its type and range, and
+// an error names its dotted key ("work.steps: ..."), never a bare json exception or a number
+// converted with undefined behaviour (steps = 1e300 read as a long long).
+class RecordReader {
+ public:
+  [[noreturn]] static void fail(const std::string& key, const std::string& why) {
+    throw SweepRecordError(key + ": " + why);
+  }
+  static std::string dotted(const std::string& prefix, const char* key) {
+    return prefix.empty() ? std::string(key) : prefix + "." + key;
+  }
+  static const json& at(const json& j, const std::string& prefix, const char* key) {
+    if (!j.is_object()) fail(prefix.empty() ? "record" : prefix, std::string("expected an object, got ") + j.type_name());
+    const auto it = j.find(key);
+    if (it == j.end()) fail(dotted(prefix, key), "missing");
+    return *it;
+  }
+  static std::string string(const json& j, const std::string& prefix, const char* key) {
+    const json& v = at(j, prefix, key);
+    if (!v.is_string()) fail(dotted(prefix, key), std::string("expected a string, got ") + v.type_name());
+    return v.get<std::string>();
+  }
+  // A number or null (NaN: not finite when written); `lo` bounds it from below when given.
+  static double number(const json& j, const std::string& prefix, const char* key,
+                       double lo = -std::numeric_limits<double>::infinity()) {
+    const json& v = at(j, prefix, key);
+    if (v.is_null()) return std::nan("");
+    if (!v.is_number()) fail(dotted(prefix, key), std::string("expected a number or null, got ") + v.type_name());
+    const double x = v.get<double>();
+    if (!(x >= lo)) fail(dotted(prefix, key), v.dump() + " is out of range (expected >= " + num(lo) + ")");
+    return x;
+  }
+  static std::optional<double> optional(const json& j, const std::string& prefix, const char* key) {
+    const double x = number(j, prefix, key);
+    if (std::isnan(x)) return std::nullopt;
+    return x;
+  }
+  // An integer in [lo, hi]: a float, a string or a value beyond long long is refused by name.
+  static long long integer(const json& j, const std::string& prefix, const char* key, long long lo, long long hi) {
+    const json& v = at(j, prefix, key);
+    const std::string k = dotted(prefix, key);
+    const std::string range = std::to_string(lo) + " <= " + key + " <= " + std::to_string(hi);
+    if (!v.is_number_integer())
+      fail(k, (v.is_number() ? v.dump() + " is not an integer" : std::string("expected an integer, got ") + v.type_name()) +
+                  " (expected " + range + ")");
+    long long x = 0;
+    if (v.is_number_unsigned()) {
+      if (v.get<std::uint64_t>() > static_cast<std::uint64_t>(hi)) fail(k, v.dump() + " is out of range (expected " + range + ")");
+      x = static_cast<long long>(v.get<std::uint64_t>());
+    } else {
+      x = v.get<long long>();
+    }
+    if (x < lo || x > hi) fail(k, v.dump() + " is out of range (expected " + range + ")");
+    return x;
+  }
+  // One of `names`.
+  static std::string name(const json& j, const std::string& prefix, const char* key,
+                          std::initializer_list<const char*> names) {
+    const std::string v = string(j, prefix, key);
+    std::string list;
+    for (const char* n : names) {
+      if (v == n) return v;
+      list += (list.empty() ? "" : ", ") + std::string(n);
+    }
+    fail(dotted(prefix, key), "\"" + utf8_replaced(v.substr(0, 40)) + "\" is not one of " + list);
+  }
+};
+
+// Bounds of a record's counts: a point's indices are below the plan's size, repeats as in a
+// sweep file, work counters are counts (long long holds any a run can reach).
+constexpr long long kMaxCount = std::numeric_limits<long long>::max();
 
 json reference_json(const std::optional<SweepRecord::ReferenceRun>& f) {
   if (!f) return nullptr;
@@ -480,71 +553,92 @@ json to_json(const SweepRecord& r) {
 }
 
 SweepRecord sweep_record_from_json(const json& j) {
-  if (j.at("format").get<std::string>() != "tippe-sweep-record-1")
-    throw std::invalid_argument("unknown record format \"" + j.at("format").get<std::string>() + "\"");
+  using R = RecordReader;
+  const std::string format = R::string(j, "", "format");
+  if (format != "tippe-sweep-record-1")
+    R::fail("format", "unknown record format \"" + utf8_replaced(format.substr(0, 40)) + "\" (expected tippe-sweep-record-1)");
+  const long long max_index = static_cast<long long>(kMaxSweepPoints) - 1;
   SweepRecord r;
-  r.point_id = j.at("point_id").get<std::string>();
-  r.scene = j.at("scene").get<std::string>();
-  r.scene_file = j.at("scene_file").get<std::string>();
-  r.physics_hash = j.at("physics_hash").get<std::string>();
-  r.scene_index = j.at("scene_index").get<long long>();
-  r.setup = j.at("setup").get<std::string>();
-  r.engine = j.at("engine").get<std::string>();
+  r.point_id = R::string(j, "", "point_id");
+  r.scene = R::string(j, "", "scene");
+  r.scene_file = R::string(j, "", "scene_file");
+  r.physics_hash = R::string(j, "", "physics_hash");
+  r.scene_index = R::integer(j, "", "scene_index", 0, max_index);
+  r.setup = R::string(j, "", "setup");
+  r.engine = R::string(j, "", "engine");
   // Names read back become file names and report labels: the rule of names in input files.
   for (const auto& [key, name] : {std::pair<const char*, const std::string*>{"scene", &r.scene},
                                   {"setup", &r.setup},
                                   {"engine", &r.engine}})
-    if (!is_valid_name(*name))
-      throw std::invalid_argument(std::string(key) + ": \"" + *name + "\" is not a usable name (" + kNameRule + ")");
-  r.set = j.at("set").get<std::vector<std::string>>();
-  r.ladder_key = j.at("ladder_key").get<std::string>();
-  r.ladder_value = get_number(j, "ladder_value");
-  r.setup_index = j.at("setup_index").get<long long>();
-  r.ladder_index = j.at("ladder_index").get<long long>();
-  r.repeats = j.at("repeats").get<long long>();
-  r.duration = get_number(j, "duration");
-  r.status = j.at("status").get<std::string>();
-  r.status_time = get_number(j, "status_time");
-  r.status_detail = j.at("status_detail").get<std::string>();
-  r.inversion_time = get_optional(j, "inversion_time");
-  r.stem_contact_time = get_optional(j, "stem_contact_time");
-  r.reference_inversion_time = get_optional(j, "reference_inversion_time");
-  r.reference_stem_contact_time = get_optional(j, "reference_stem_contact_time");
-  r.metrics = metrics_from_json(j.at("metrics"));
-  const json& w = j.at("work");
-  r.cpu_seconds = get_number(w, "cpu_seconds");
-  for (const json& c : w.at("cpu_seconds_repeats"))
+    if (!is_valid_name(*name)) R::fail(key, "\"" + *name + "\" is not a usable name (" + kNameRule + ")");
+  const json& set = R::at(j, "", "set");
+  if (!set.is_array()) R::fail("set", std::string("expected an array, got ") + set.type_name());
+  for (size_t i = 0; i < set.size(); ++i) {
+    if (!set[i].is_string()) R::fail("set[" + std::to_string(i) + "]", std::string("expected a string, got ") + set[i].type_name());
+    r.set.push_back(set[i].get<std::string>());
+  }
+  r.ladder_key = R::string(j, "", "ladder_key");
+  r.ladder_value = R::number(j, "", "ladder_value");
+  r.setup_index = R::integer(j, "", "setup_index", 0, max_index);
+  r.ladder_index = R::integer(j, "", "ladder_index", 0, max_index);
+  r.repeats = R::integer(j, "", "repeats", 1, kMaxRepeats);
+  r.duration = R::number(j, "", "duration", 0.0);
+  // Any status reads (a newer build's reads with the class "failed" when no class is written); the
+  // class, which names the report's CSS classes, must be a known one.
+  r.status = R::string(j, "", "status");
+  r.status_time = R::number(j, "", "status_time");
+  r.status_detail = R::string(j, "", "status_detail");
+  r.inversion_time = R::optional(j, "", "inversion_time");
+  r.stem_contact_time = R::optional(j, "", "stem_contact_time");
+  r.reference_inversion_time = R::optional(j, "", "reference_inversion_time");
+  r.reference_stem_contact_time = R::optional(j, "", "reference_stem_contact_time");
+  try {
+    r.metrics = metrics_from_json(R::at(j, "", "metrics"));
+  } catch (const json::exception& e) {
+    // metrics_from_json names the field in its own words after json's "[json.exception...] ".
+    std::string why = e.what();
+    if (const size_t close = why.find("] "); close != std::string::npos) why.erase(0, close + 2);
+    R::fail("metrics", why);
+  }
+  const json& w = R::at(j, "", "work");
+  r.cpu_seconds = R::number(w, "work", "cpu_seconds", 0.0);
+  const json& cpu = R::at(w, "work", "cpu_seconds_repeats");
+  if (!cpu.is_array() || cpu.size() > static_cast<size_t>(kMaxRepeats))
+    R::fail("work.cpu_seconds_repeats", "expected an array of at most " + std::to_string(kMaxRepeats) + " numbers");
+  for (const json& c : cpu) {
+    if (!c.is_null() && !c.is_number()) R::fail("work.cpu_seconds_repeats", std::string("expected numbers, got ") + c.type_name());
     r.cpu_seconds_repeats.push_back(c.is_null() ? std::nan("") : c.get<double>());
-  r.wall_seconds = get_number(w, "wall_seconds");
-  r.steps = w.at("steps").get<long long>();
-  r.rhs_evaluations = w.at("rhs_evaluations").get<long long>();
-  r.solver_iterations = w.at("solver_iterations").get<long long>();
-  r.engine_version = j.at("engine_version").get<std::string>();
-  r.git_commit = j.at("git_commit").get<std::string>();
-  r.settings = j.at("settings");
-  if (!r.settings.is_object()) throw std::invalid_argument("settings: expected an object");
+  }
+  r.wall_seconds = R::number(w, "work", "wall_seconds", 0.0);
+  r.steps = R::integer(w, "work", "steps", 0, kMaxCount);
+  r.rhs_evaluations = R::integer(w, "work", "rhs_evaluations", 0, kMaxCount);
+  r.solver_iterations = R::integer(w, "work", "solver_iterations", 0, kMaxCount);
+  r.engine_version = R::string(j, "", "engine_version");
+  r.git_commit = R::string(j, "", "git_commit");
+  r.settings = R::at(j, "", "settings");
+  if (!r.settings.is_object()) R::fail("settings", std::string("expected an object, got ") + r.settings.type_name());
   if (j.contains("class")) {
-    const json& c = j.at("class");
-    r.run_class = c.at("name").get<std::string>();
-    r.class_time = get_number(c, "time");
-    r.class_reason = c.at("reason").get<std::string>();
+    const json& c = R::at(j, "", "class");
+    r.run_class = R::name(c, "class", "name", {"ok", "diverged", "unphysical", "clamped", "failed", "contact_lost"});
+    r.class_time = R::number(c, "class", "time");
+    r.class_reason = R::string(c, "class", "reason");
   } else {
     r.run_class = class_of_status(r.status);
   }
   if (j.contains("reference") && !j.at("reference").is_null()) {
     const json& x = j.at("reference");
     SweepRecord::ReferenceRun f;
-    f.status = x.at("status").get<std::string>();
-    f.method = x.at("method").get<std::string>();
-    f.run_class = x.at("class").get<std::string>();
-    f.rtol = get_number(x, "rtol");
-    f.cpu_seconds = get_number(x, "cpu_seconds");
-    f.steps = json_integer(x, "steps");
-    f.rhs_evaluations = json_integer(x, "rhs_evaluations");
-    f.energy_initial = get_number(x, "energy_initial");
-    f.energy_final = get_number(x, "energy_final");
-    f.jellett_max_relative_drift = get_number(x, "jellett_max_relative_drift");
-    f.final_tilt = get_number(x, "final_tilt");
+    f.status = R::string(x, "reference", "status");
+    f.method = R::string(x, "reference", "method");
+    f.run_class = R::name(x, "reference", "class", {"ok", "diverged", "unphysical", "clamped", "failed", "contact_lost"});
+    f.rtol = R::number(x, "reference", "rtol", 0.0);
+    f.cpu_seconds = R::number(x, "reference", "cpu_seconds", 0.0);
+    f.steps = R::integer(x, "reference", "steps", 0, kMaxCount);
+    f.rhs_evaluations = R::integer(x, "reference", "rhs_evaluations", 0, kMaxCount);
+    f.energy_initial = R::number(x, "reference", "energy_initial");
+    f.energy_final = R::number(x, "reference", "energy_final");
+    f.jellett_max_relative_drift = R::number(x, "reference", "jellett_max_relative_drift");
+    f.final_tilt = R::number(x, "reference", "final_tilt");
     r.reference = f;
   }
   return r;
@@ -560,11 +654,8 @@ size_t complete_lines_length(const std::string& text) {
   return last == std::string::npos ? 0 : last + 1;
 }
 
-RecordsFile read_records(const std::string& path) {
+RecordsFile parse_records_text(const std::string& text, const std::string& name) {
   RecordsFile f;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return f;
-  const std::string text = read_file_text(path);
   f.complete_bytes = complete_lines_length(text);
   f.partial_bytes = text.size() - f.complete_bytes;
   size_t pos = 0, line = 0;
@@ -574,12 +665,15 @@ RecordsFile read_records(const std::string& path) {
     const std::string l = text.substr(pos, end - pos);
     pos = end + 1;
     if (trim(l).empty()) continue;
+    const std::string where = name + ":" + std::to_string(line) + ": ";
+    const json j = json::parse(l, nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded()) throw SweepRecordError(where + "not a sweep record: not one JSON value");
     try {
-      f.records.push_back(sweep_record_from_json(json::parse(l)));
-    } catch (const std::exception& e) {
-      // Records are input too (shared, downloaded, edited): a bad one is bad input, not a bug.
-      throw SweepInputError(path + ":" + std::to_string(line) + ": not a sweep record: " + e.what());
+      f.records.push_back(sweep_record_from_json(j));
+    } catch (const SweepRecordError& e) {
+      throw SweepRecordError(where + e.what());
     }
+    f.lines.push_back(line);
   }
   return f;
 }
@@ -596,6 +690,12 @@ fs::path keep_aside(const fs::path& file) {
   }
 }
 
+RecordsFile read_records(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return {};
+  return parse_records_text(read_file_text(path), path);
+}
+
 RecordsFile recover_records(const std::string& path) {
   RecordsFile f = read_records(path);
   if (f.partial_bytes == 0) return f;
@@ -608,6 +708,39 @@ RecordsFile recover_records(const std::string& path) {
   return f;
 }
 
+SweepMeta parse_sweep_meta(const std::string& text, const std::string& name) {
+  using R = RecordReader;
+  SweepMeta m;
+  m.meta = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  try {
+    if (m.meta.is_discarded()) R::fail("sweep.json", "not JSON");
+    m.sweep_hash = R::string(m.meta, "", "sweep_hash");
+    m.plan_hash = R::string(m.meta, "", "plan_hash");
+    if (m.meta.contains("points"))
+      m.points = static_cast<size_t>(R::integer(m.meta, "", "points", 0, static_cast<long long>(kMaxSweepPoints)));
+    const json shard = m.meta.value("shard", json(nullptr));
+    if (!shard.is_null()) {
+      // The bound of parse_shard, so that a shard read back is one `--shard` could have made.
+      const long long count = R::integer(shard, "shard", "count", 1, 1000000);
+      const long long index = R::integer(shard, "shard", "index", 0, count - 1);
+      m.shard = SweepShard{static_cast<int>(index), static_cast<int>(count)};
+      const json& ids = R::at(shard, "shard", "point_ids");
+      if (!ids.is_array()) R::fail("shard.point_ids", std::string("expected an array, got ") + ids.type_name());
+      if (ids.size() > m.points.value_or(kMaxSweepPoints))
+        R::fail("shard.point_ids", std::to_string(ids.size()) + " ids, more than the sweep's " +
+                                       std::to_string(m.points.value_or(kMaxSweepPoints)) + " points");
+      for (size_t i = 0; i < ids.size(); ++i) {
+        if (!ids[i].is_string())
+          R::fail("shard.point_ids[" + std::to_string(i) + "]", std::string("expected a string, got ") + ids[i].type_name());
+        m.shard_point_ids.push_back(ids[i].get<std::string>());
+      }
+    }
+  } catch (const SweepRecordError& e) {
+    throw SweepRecordError(name + ": " + e.what());
+  }
+  return m;
+}
+
 // ---- running ----------------------------------------------------------------------------------
 
 namespace {
@@ -617,7 +750,40 @@ struct Reference {
   RunRecord record;
   Trajectory trajectory;
   std::optional<SweepRecord::ReferenceRun> summary;  // filled once loaded or computed
+  // A reference that failed is a result: every point of its scene is recorded as failed with
+  // this reason (non-empty) instead of being run against nothing.
+  std::string failure;
+  double failure_time = std::nan("");
 };
+
+// A point whose scene's reference failed: a failed record carrying the reference's reason, so that
+// the other scenes' points run and the report shows which scene and why.
+SweepRecord reference_failed_record(SweepRecord r, const Scene& scene, const Reference& ref) {
+  const double nan = std::nan("");
+  r.status = to_string(RunStatus::Failed);
+  r.status_time = ref.failure_time;
+  r.status_detail = "not run: " + ref.failure;
+  r.run_class = "failed";
+  r.class_time = ref.failure_time;
+  r.class_reason = r.status_detail;
+  Metrics& m = r.metrics;
+  m.inversion_event = m.stem_contact_event = "no_reference";
+  for (double* v : {&m.tilt_max_error, &m.tilt_rms_error, &m.energy_max_error, &m.energy_final_ratio,
+                    &m.energy_max_gain, &m.contact_path_rms_error, &m.contact_path_max_error, &m.com_path_rms_error,
+                    &m.com_path_max_error, &m.latitude_rms_error, &m.jellett_max_relative_drift, &m.wall_seconds,
+                    &m.cpu_seconds, &m.real_time_factor, &m.cost_ratio, &m.compared_until})
+    *v = nan;
+  r.cpu_seconds = r.wall_seconds = 0;
+  r.cpu_seconds_repeats = {0.0};
+  r.engine_version = "unknown";
+  SweepRecord::ReferenceRun f;
+  f.status = f.run_class = "failed";
+  f.method = scene.run.method;
+  f.rtol = scene.run.rtol;
+  f.cpu_seconds = f.energy_initial = f.energy_final = f.jellett_max_relative_drift = f.final_tilt = nan;
+  r.reference = f;
+  return r;
+}
 
 SweepRecord::ReferenceRun reference_summary(const Scene& scene, const Reference& ref) {
   SweepRecord::ReferenceRun f;
@@ -656,23 +822,52 @@ std::pair<std::string, std::string> unpack_texts(const std::string& bytes, size_
   return {std::move(summary), field()};
 }
 
+// What a reference's task sends back: 'R' and its two cache files' texts, or 'F' and, for a
+// reference that failed, the time and the reason (a result, not an error: its scene's points are
+// recorded as failed).
+std::string failed_reference_text(double time, const std::string& why) {
+  return "F" + pack_texts(json(number(time)).dump(), why);
+}
+// Reads a failed_reference_text at `pos` into ref; false (pos unmoved) for an 'R' entry.
+bool read_failed_reference(const std::string& bytes, size_t& pos, Reference& ref) {
+  if (pos >= bytes.size() || (bytes[pos] != 'F' && bytes[pos] != 'R')) throw std::runtime_error("reference message cut short");
+  if (bytes[pos] == 'R') {
+    ++pos;
+    return false;
+  }
+  ++pos;
+  const auto [time, why] = unpack_texts(bytes, pos);
+  const json t = json::parse(time);
+  ref.failure_time = t.is_number() ? t.get<double>() : std::nan("");
+  ref.failure = why;
+  return true;
+}
+
 // Runs the reference at the scene's own tolerances, on whichever process the task lands.
 std::string compute_reference_texts(const Scene& scene) {
   CsvTrajectoryText csv;
   TrajectorySink sink({&csv});
-  auto sim = make_simulator("analytic", scene);
-  const RunRecord record = run_simulator(*sim, scene, &sink);
-  sim.reset();
+  RunRecord record;
+  try {
+    auto sim = make_simulator("analytic", scene);
+    record = run_simulator(*sim, scene, &sink);
+  } catch (const std::exception& e) {
+    return failed_reference_text(sink.trajectory.size() ? sink.trajectory.t.back() : 0.0,
+                                 "the reference run of " + scene.name + " failed: exception: " + e.what());
+  }
   if (record.status == to_string(RunStatus::Failed) || sink.trajectory.size() == 0)
-    throw std::runtime_error("reference run of " + scene.name + " failed: " + record.status_detail);
-  return pack_texts(to_json(record).dump(2) + "\n", csv.text);
+    return failed_reference_text(record.status_time, "the reference run of " + scene.name + " failed at t = " +
+                                                         num(record.status_time) + ": " + record.status_detail);
+  return "R" + pack_texts(to_json(record).dump(2) + "\n", csv.text);
 }
 
 // Into the cache (the summary last, so that its presence says the trajectory beside it is
-// complete) and into memory, read back from the very texts every other rank will read.
+// complete) and into memory, read back from the very texts every other rank will read. A failed
+// reference is kept in memory only: the next run of the sweep finds its points recorded.
 void store_reference(const fs::path& dir, const Scene& scene, const std::string& hash, const std::string& texts,
                      Reference& ref) {
   size_t pos = 0;
+  if (read_failed_reference(texts, pos, ref)) return;
   const auto [summary, csv] = unpack_texts(texts, pos);
   fs::create_directories(dir);
   write_file_atomic((dir / "trajectory.csv").string(), csv);
@@ -719,6 +914,7 @@ SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Referenc
   r.reference_inversion_time = ref.record.inversion_time;
   r.reference_stem_contact_time = ref.record.stem_contact_time;
   r.git_commit = build_info().git_commit;
+  if (!ref.failure.empty()) return reference_failed_record(std::move(r), p.scene, ref);
 
   RunRecord first;
   TrajectorySink sink;
@@ -990,9 +1186,9 @@ json sweep_json(const SweepPlan& plan, const json& shard) {
 }
 
 
-std::string shard_text(const json& shard) {
-  if (shard.is_null()) return "the whole sweep";
-  return "shard " + std::to_string(shard.at("index").get<int>()) + "/" + std::to_string(shard.at("count").get<int>());
+std::string shard_text(const std::optional<SweepShard>& shard) {
+  if (!shard) return "the whole sweep";
+  return "shard " + std::to_string(shard->index) + "/" + std::to_string(shard->count);
 }
 
 // What the coordinator found in OUT and decided, shared with every rank: which points run, in
@@ -1056,29 +1252,30 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<O
   bool fresh = true;
   std::error_code ec;
   if (fs::exists(sweep_file, ec)) {
-    json old;
+    std::optional<SweepMeta> old;
     try {
-      std::ifstream in(sweep_file);
-      old = json::parse(in);
-      const std::string h = old.at("sweep_hash").get<std::string>(), ph = old.at("plan_hash").get<std::string>();
+      old = parse_sweep_meta(read_file_text(sweep_file.string()), sweep_file.string());
+    } catch (const std::exception& e) {
+      if (!o.restart)
+        throw SweepInputError(std::string(e.what()) + " (not a sweep record); give --restart to begin the directory again");
+    }
+    if (old) {
+      const std::string& h = old->sweep_hash;
+      const std::string& ph = old->plan_hash;
       if (h != plan.spec.hash && !o.restart)
         throw SweepInputError(sweep_file.string() + ": sweep_hash: " + out.string() +
-                              " was started with another sweep file (hash " + h + ", " + plan.spec.file + " now has " +
-                              plan.spec.hash + "); give --restart to begin it again, or another --out");
+                              " was started with another sweep file (hash " + utf8_replaced(h) + ", " + plan.spec.file +
+                              " now has " + plan.spec.hash + "); give --restart to begin it again, or another --out");
       if (ph != plan.plan_hash && !o.restart)
         throw SweepInputError(sweep_file.string() + ": plan_hash: the physics of a scene of " + plan.spec.file +
                               " changed since " + out.string() +
                               " was started; give --restart to begin it again, or another --out");
-      const json old_shard = old.value("shard", json(nullptr));
+      const json old_shard = old->meta.value("shard", json(nullptr));
       if (old_shard != shard && h == plan.spec.hash && ph == plan.plan_hash && !o.restart)
-        throw SweepInputError(sweep_file.string() + ": shard: " + out.string() + " holds " + shard_text(old_shard) +
-                              ", this run is " + shard_text(shard) +
+        throw SweepInputError(sweep_file.string() + ": shard: " + out.string() + " holds " + shard_text(old->shard) +
+                              ", this run is " + shard_text(o.shard) +
                               "; give each shard its own --out (or --restart to begin it again)");
       fresh = h != plan.spec.hash || ph != plan.plan_hash || old_shard != shard;
-    } catch (const json::exception& e) {
-      if (!o.restart)
-        throw SweepInputError(sweep_file.string() + ": not a sweep record (" + e.what() +
-                              "); give --restart to begin the directory again");
     }
   } else if (fs::exists(records_file, ec) && !o.restart) {
     throw SweepInputError(records_file.string() + ": records without " + sweep_file.string() +
@@ -1094,11 +1291,35 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<O
 
   Prepared p;
   p.share = share.size();
-  const RecordsFile existing = recover_records(records_file.string());
+  RecordsFile existing;
+  try {
+    existing = recover_records(records_file.string());
+  } catch (const std::exception& e) {
+    throw SweepInputError(std::string(e.what()) + "; give --restart to begin the directory again, or another --out");
+  }
   p.partial_bytes = existing.partial_bytes;
   if (existing.partial_bytes)
     std::fprintf(stderr, "tippe: %s: dropped a partial last line (%zu bytes); its point runs again\n",
                  records_file.string().c_str(), existing.partial_bytes);
+  // Records read back are input: each must be a point of this run's share, where the plan has it.
+  std::map<std::string, size_t> in_share;
+  for (size_t i : share) in_share.emplace(plan.points[i].id, i);
+  for (size_t k = 0; k < existing.records.size(); ++k) {
+    const SweepRecord& r = existing.records[k];
+    const std::string where = records_file.string() + ":" + std::to_string(existing.lines[k]) + ": ";
+    const auto it = in_share.find(r.point_id);
+    if (it == in_share.end())
+      throw SweepInputError(where + "point_id: " + utf8_replaced(r.point_id.substr(0, 40)) + " is not a point of " +
+                            (o.shard ? shard_text(o.shard) + " of " : std::string()) + plan.spec.file +
+                            "'s plan; give --restart to begin the directory again, or another --out");
+    const SweepPoint& p = plan.points[it->second];
+    for (const auto& [key, got, want] :
+         {std::make_tuple("scene_index", r.scene_index, p.scene_index), std::make_tuple("setup_index", r.setup_index, p.setup_index),
+          std::make_tuple("ladder_index", r.ladder_index, p.ladder_index)})
+      if (got != static_cast<long long>(want))
+        throw SweepInputError(where + key + ": " + std::to_string(got) + " is not point " + r.point_id + "'s (" +
+                              std::to_string(want) + " in the plan); give --restart to begin the directory again");
+  }
   std::set<std::string> done;
   size_t duplicates = 0;
   for (const SweepRecord& r : existing.records) duplicates += !done.insert(r.point_id).second;
@@ -1246,9 +1467,13 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
     const std::string bytes = from_coordinator(farm, [&] {
       std::string texts;
       for (size_t i : prep.needed) {
+        if (!refs[i].failure.empty()) {
+          texts += failed_reference_text(refs[i].failure_time, refs[i].failure);
+          continue;
+        }
         const fs::path dir = out / "reference" / plan.physics_hashes[i];
-        texts += pack_texts(read_file_text((dir / "summary.json").string()),
-                            read_file_text((dir / "trajectory.csv").string()));
+        texts += "R" + pack_texts(read_file_text((dir / "summary.json").string()),
+                                  read_file_text((dir / "trajectory.csv").string()));
       }
       return texts;
     });
@@ -1257,6 +1482,7 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
       try {
         size_t pos = 0;
         for (size_t i : prep.needed) {
+          if (read_failed_reference(bytes, pos, refs[i])) continue;
           const auto [summary, csv] = unpack_texts(bytes, pos);
           const std::string why = reference_from_text(summary, csv, plan.scenes[i], plan.physics_hashes[i],
                                                       "the reference of " + plan.scenes[i].name + " from rank 0",
@@ -1270,7 +1496,15 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
     error = first_error(farm, error);
     if (!error.empty()) throw std::runtime_error(error);
   }
-  for (size_t i : prep.needed) refs[i].summary = reference_summary(plan.scenes[i], refs[i]);
+  for (size_t i : prep.needed)
+    if (refs[i].failure.empty()) refs[i].summary = reference_summary(plan.scenes[i], refs[i]);
+  if (farm.coordinator())
+    for (size_t i : prep.needed)
+      if (!refs[i].failure.empty()) {
+        size_t n = 0;
+        for (size_t q : prep.todo) n += plan.points[q].scene_index == i;
+        std::fprintf(stderr, "tippe: warning: %s; its %zu point(s) are recorded as failed\n", refs[i].failure.c_str(), n);
+      }
 
   // 4. The points: each runs once, on some worker; the coordinator appends its line.
   if (!prep.todo.empty()) {

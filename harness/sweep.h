@@ -86,6 +86,26 @@ std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& se
 
 // ---- records ----------------------------------------------------------------------------------
 
+// A sweep's plan is refused above this many points, before a single one is loaded: each point
+// loads its scene (about a millisecond), and the largest shipped sweep has 264. 1e5 points is a
+// day of planning-free running at ~1 s a point on 100 cores; more is likelier a runaway ladder.
+constexpr size_t kMaxSweepPoints = 100000;
+
+// Input a sweep cannot start with (jobs < 1, an output directory started with another sweep,
+// or in use): found before anything is written; `tippe sweep` exits 2.
+class SweepInputError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// A record (or sweep.json) read back that is not one: "KEY: reason", KEY dotted
+// ("work.steps"); read_records puts "FILE:LINE: " before it. Records are input (shared,
+// downloaded, edited): bad ones are bad input, exit 2, like a bad sweep file.
+class SweepRecordError : public SweepInputError {
+ public:
+  using SweepInputError::SweepInputError;
+};
+
 // One line of records.jsonl: a finished point, with everything the report needs.
 struct SweepRecord {
   std::string point_id;
@@ -127,8 +147,9 @@ struct SweepRecord {
   std::optional<ReferenceRun> reference;  // absent in records written before it existed
 };
 nlohmann::json to_json(const SweepRecord& r);
-// Throws nlohmann::json::exception for a missing or mistyped field, std::invalid_argument for
-// another format.
+// Every field checked for its type and range (indices 0 <= i < kMaxSweepPoints, repeats as in a
+// sweep file, counts >= 0, times and costs numbers or null, the class a known name);
+// throws SweepRecordError "KEY: reason" for anything else, another format included.
 SweepRecord sweep_record_from_json(const nlohmann::json& j);
 // One line of records.jsonl, '\n' included.
 std::string to_jsonl(const SweepRecord& r);
@@ -138,14 +159,16 @@ size_t complete_lines_length(const std::string& text);
 
 struct RecordsFile {
   std::vector<SweepRecord> records;  // complete lines, in file order
+  std::vector<size_t> lines;         // the 1-based line of each record
   size_t complete_bytes = 0;         // bytes of the complete lines
   size_t partial_bytes = 0;          // a last line without '\n' (a write cut short), dropped
 };
-
-// Reads records.jsonl (a missing file is empty). A complete line that is not a record (records
-// are input: a name breaking is_valid_name included) throws SweepInputError "FILE:LINE: reason";
-// a partial last line is only measured.
+// Reads records.jsonl (a missing file is empty; one over kMaxRecordFileBytes throws
+// std::runtime_error). A complete line that is not a record throws SweepRecordError
+// "FILE:LINE: KEY: reason"; a partial last line is only measured.
 RecordsFile read_records(const std::string& path);
+// The same on the file's text, `name` standing for the file; throws only SweepRecordError.
+RecordsFile parse_records_text(const std::string& text, const std::string& name);
 // read_records, then truncates the file to its complete lines (fsynced) when the last is partial.
 RecordsFile recover_records(const std::string& path);
 // Renames `file`, when it exists, to the first free name of FILE.old, FILE.old.2, FILE.old.3, ...
@@ -153,12 +176,26 @@ RecordsFile recover_records(const std::string& path);
 // when there was no file. Throws std::runtime_error naming the file when the rename fails.
 std::filesystem::path keep_aside(const std::filesystem::path& file);
 
-// ---- running ----------------------------------------------------------------------------------
-
 // One of N deterministic shares of a sweep's points (`--shard I/N`), for job arrays.
 struct SweepShard {
   int index = 0, count = 1;
 };
+
+// sweep.json read back: the fields a resumed run and a merge use, each checked.
+struct SweepMeta {
+  nlohmann::json meta;  // the whole object
+  std::string sweep_hash, plan_hash;
+  std::optional<size_t> points;  // absent in files from before it existed
+  std::optional<SweepShard> shard;
+  std::vector<std::string> shard_point_ids;
+};
+// Throws SweepRecordError "NAME: KEY: reason": not JSON, sweep_hash or plan_hash not a string,
+// points not an integer in [0, kMaxSweepPoints], shard not null or {index, count, point_ids} with
+// 1 <= count <= 1000000, 0 <= index < count and at most `points` ids.
+SweepMeta parse_sweep_meta(const std::string& text, const std::string& name);
+
+// ---- running ----------------------------------------------------------------------------------
+
 // "I/N" with 0 <= I < N <= 1000000; throws std::invalid_argument quoting the text.
 SweepShard parse_shard(const std::string& text);
 // The indices into plan.points of shard I of N, increasing. The shares partition the points and
@@ -174,12 +211,6 @@ struct SweepOptions {
   bool plots = true;     // gnuplot SVGs in the report
 };
 
-// Input a sweep cannot start with (jobs < 1, an output directory started with another sweep,
-// or in use): found before anything is written; `tippe sweep` exits 2.
-class SweepInputError : public std::invalid_argument {
- public:
-  using std::invalid_argument::invalid_argument;
-};
 
 struct SweepOutcome {
   size_t points = 0, skipped = 0, ran = 0;  // skipped: finished by an earlier run of the same DIR

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -11,6 +12,7 @@
 #include "output_dir.h"
 #include "provenance.h"
 #include "records.h"
+#include "scene_io.h"
 #include "sweep.h"
 
 namespace tippe {
@@ -24,6 +26,7 @@ struct ShardDir {
   fs::path dir;
   json meta;
   int index = 0, count = 0;
+  size_t points = 0;
   std::vector<std::string> ids;  // the shard's points, in plan order
   std::vector<SweepRecord> records;
 };
@@ -42,26 +45,25 @@ ShardDir read_shard(const fs::path& dir) {
   const fs::path meta = dir / "sweep.json", records = dir / "records.jsonl";
   std::error_code ec;
   if (!fs::is_regular_file(meta, ec)) refuse(dir.string() + ": no sweep.json (not a sweep directory)");
+  SweepMeta m;
   try {
-    std::ifstream in(meta);
-    s.meta = json::parse(in);
-    s.meta.at("sweep_hash").get<std::string>();
-    s.meta.at("plan_hash").get<std::string>();
-    s.meta.at("points").get<size_t>();
-    const json& shard = s.meta.value("shard", json(nullptr));
-    if (shard.is_null())
-      refuse(meta.string() + ": shard: not a shard (it holds the whole sweep); merge takes the directories of "
-                             "`tippe sweep SWEEP --shard I/N`");
-    s.index = shard.at("index").get<int>();
-    s.count = shard.at("count").get<int>();
-    s.ids = shard.at("point_ids").get<std::vector<std::string>>();
-  } catch (const json::exception& e) {
-    refuse(meta.string() + ": not a sweep record (" + e.what() + ")");
+    m = parse_sweep_meta(read_file_text(meta.string()), meta.string());
+  } catch (const std::exception& e) {
+    refuse(std::string(e.what()) + " (not a sweep record)");
   }
+  if (!m.points) refuse(meta.string() + ": points: missing (not a shard of this version's `tippe sweep --shard`)");
+  if (!m.shard)
+    refuse(meta.string() + ": shard: not a shard (it holds the whole sweep); merge takes the directories of "
+                           "`tippe sweep SWEEP --shard I/N`");
+  s.meta = std::move(m.meta);
+  s.points = *m.points;
+  s.index = m.shard->index;
+  s.count = m.shard->count;
+  s.ids = std::move(m.shard_point_ids);
   RecordsFile f;
   try {
     f = read_records(records.string());
-  } catch (const std::runtime_error& e) {
+  } catch (const std::exception& e) {
     refuse(e.what());
   }
   if (f.partial_bytes)
@@ -88,12 +90,15 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
 
   // Everything is read and checked before the output directory is touched.
   std::vector<ShardDir> shards;
+  // The shard directories are written into sweep.json (merged_from): JSON, so UTF-8.
+  for (const std::string& d : shard_dirs)
+    if (!is_valid_utf8(d)) refuse(utf8_replaced(d) + ": the path is not valid UTF-8 (sweep.json records it)");
   for (const std::string& d : shard_dirs) {
     if (same_dir(d, out)) refuse(d + ": is the --out directory; merge into a new directory");
     shards.push_back(read_shard(d));
   }
   const ShardDir& first = shards.front();
-  const std::string sweep_hash = first.meta["sweep_hash"], plan_hash = first.meta["plan_hash"];
+  const std::string sweep_hash = first.meta["sweep_hash"], plan_hash = first.meta["plan_hash"];  // checked strings
   std::map<int, const ShardDir*> by_index;
   for (const ShardDir& s : shards) {
     const std::string h = s.meta["sweep_hash"], ph = s.meta["plan_hash"];
@@ -136,9 +141,9 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
     for (const std::string& id : own)
       if (!all_ids.insert(id).second) refuse(s.dir.string() + ": point " + id + " is also in another shard");
   }
-  if (all_ids.size() != first.meta["points"].get<size_t>())
+  if (all_ids.size() != first.points)
     refuse("the shards hold " + std::to_string(all_ids.size()) + " points, the sweep has " +
-           first.meta["points"].dump());
+           std::to_string(first.points));
   if (commits.size() > 1) {
     std::string list;
     for (const std::string& c : commits) list += (list.empty() ? "" : ", ") + c;
@@ -153,14 +158,14 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
   const fs::path meta_file = out / "sweep.json", records_file = out / "records.jsonl";
   std::error_code ec;
   if (fs::exists(meta_file, ec)) {
-    json old;
+    std::optional<SweepMeta> old;
     try {
-      std::ifstream in(meta_file);
-      old = json::parse(in);
-    } catch (const json::exception&) {
+      old = parse_sweep_meta(read_file_text(meta_file.string()), meta_file.string());
+    } catch (const std::exception&) {
+      // Not a sweep's: refused below unless --restart.
     }
-    const bool earlier_merge = old.is_object() && old.value("sweep_hash", "") == sweep_hash &&
-                               old.value("plan_hash", "") == plan_hash && old.contains("merged_from");
+    const bool earlier_merge = old && old->sweep_hash == sweep_hash && old->plan_hash == plan_hash &&
+                               old->meta.contains("merged_from");
     if (!earlier_merge && !restart)
       refuse(meta_file.string() + ": " + out.string() +
              " holds another sweep or a run of its own; give another --out, or --restart to begin it again");

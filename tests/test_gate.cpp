@@ -421,6 +421,19 @@ TEST(GateRender, TableHasOneRowPerLineAndNamesFailures) {
   EXPECT_NE(t.find("ode-tight: tilt_rms_error 0.02 > 0.001"), std::string::npos) << t;
 }
 
+// Bytes that are not UTF-8 (a path, an engine's status detail) would make the document, which
+// declares UTF-8, malformed: they are replaced by U+FFFD.
+TEST(GateRender, JunitStaysUtf8WhateverTheBytesOfItsNames) {
+  auto results = mixed_results();
+  results[1].rows.back().message = "detail \xff\xfe bytes";
+  results[1].rows.back().passed = false;
+  const std::string xml = render_junit(results, "gates/\xff.toml");
+  EXPECT_TRUE(is_valid_utf8(xml)) << xml;
+  EXPECT_NE(xml.find("gates/\xEF\xBF\xBD.toml"), std::string::npos) << xml;
+  EXPECT_EQ(utf8_replaced("a\xff\xc3\xa9"), "a\xEF\xBF\xBD\xc3\xa9");
+  EXPECT_EQ(utf8_replaced("\xe2\x82"), "\xEF\xBF\xBD\xEF\xBF\xBD");
+}
+
 TEST(GateRender, JunitParsesBackWithMatchingCounts) {
   const auto results = mixed_results();
   const std::string suite = "gates/a&b <\"x\">.toml";

@@ -122,10 +122,10 @@ TEST(SweepRecords, JsonLineRoundTrip) {
 TEST(SweepRecords, MissingFieldOrOtherFormatThrows) {
   json j = to_json(sample_record());
   j.erase("point_id");
-  EXPECT_THROW(sweep_record_from_json(j), json::exception);
+  EXPECT_THROW(sweep_record_from_json(j), SweepRecordError);
   json k = to_json(sample_record());
   k["format"] = "tippe-sweep-record-0";
-  EXPECT_THROW(sweep_record_from_json(k), std::invalid_argument);
+  EXPECT_THROW(sweep_record_from_json(k), SweepRecordError);
 }
 
 TEST(SweepRecords, PartialLastLineIsDetectedAndDropped) {
@@ -154,6 +154,76 @@ TEST(SweepRecords, PartialLastLineIsDetectedAndDropped) {
   EXPECT_EQ(fixed.partial_bytes, cut.size());
   EXPECT_EQ(slurp(file), whole) << "truncated to the last complete line";
   EXPECT_EQ(recover_records(file.string()).partial_bytes, 0u);
+}
+
+// Records read back are input: a count beyond long long, an index out of range, a float where
+// an integer belongs, are refused by key, never converted with undefined behaviour.
+TEST(SweepRecords, FieldsReadBackAreCheckedByKey) {
+  auto message = [](const json& j) -> std::string {
+    try {
+      sweep_record_from_json(j);
+    } catch (const SweepRecordError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  json j = to_json(sample_record());
+  j["work"]["steps"] = 1e300;
+  EXPECT_EQ(message(j).rfind("work.steps: 1e+300 is not an integer", 0), 0u) << message(j);
+  j = to_json(sample_record());
+  j["work"]["rhs_evaluations"] = json::parse("18446744073709551615");
+  EXPECT_EQ(message(j).rfind("work.rhs_evaluations: 18446744073709551615 is out of range", 0), 0u) << message(j);
+  j = to_json(sample_record());
+  j["scene_index"] = -1;
+  EXPECT_EQ(message(j).rfind("scene_index: -1 is out of range (expected 0 <= scene_index <= 99999)", 0), 0u) << message(j);
+  j = to_json(sample_record());
+  j["repeats"] = 0;
+  EXPECT_EQ(message(j).rfind("repeats: 0 is out of range", 0), 0u) << message(j);
+  j = to_json(sample_record());
+  j["class"]["name"] = "fine";
+  EXPECT_EQ(message(j).rfind("class.name: \"fine\" is not one of ok, ", 0), 0u) << message(j);
+  j = to_json(sample_record());
+  j["metrics"]["steps"] = "many";
+  EXPECT_EQ(message(j).rfind("metrics: ", 0), 0u) << message(j);
+  j = to_json(sample_record());
+  j["duration"] = "long";
+  EXPECT_EQ(message(j), "duration: expected a number or null, got string");
+  EXPECT_EQ(message(json::array()).rfind("record: expected an object", 0), 0u);
+
+  TempDir dir{"tippe-sweep"};
+  const fs::path file = dir.path() / "records.jsonl";
+  j = to_json(sample_record());
+  j["work"]["steps"] = 1e300;
+  spit(file, to_jsonl(sample_record()) + j.dump() + "\n");
+  try {
+    read_records(file.string());
+    FAIL() << "no exception";
+  } catch (const SweepRecordError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(file.string() + ":2: work.steps: 1e+300 is not an integer", 0), 0u) << e.what();
+  }
+}
+
+TEST(SweepRecords, SweepJsonReadBackIsChecked) {
+  auto message = [](const std::string& text) -> std::string {
+    try {
+      parse_sweep_meta(text, "D/sweep.json");
+    } catch (const SweepRecordError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  const std::string head = R"({"sweep_hash": "a", "plan_hash": "b", "points": 4, "shard": )";
+  EXPECT_EQ(message(head + R"({"index": 1, "count": 2, "point_ids": ["x", "y"]}})"), "accepted");
+  EXPECT_EQ(message(head + R"({"index": 2, "count": 2, "point_ids": []}})"),
+            "D/sweep.json: shard.index: 2 is out of range (expected 0 <= index <= 1)");
+  EXPECT_EQ(message(head + R"({"index": 1e300, "count": 2, "point_ids": []}})"),
+            "D/sweep.json: shard.index: 1e+300 is not an integer (expected 0 <= index <= 1)");
+  EXPECT_EQ(message(head + R"({"index": 0, "count": 0, "point_ids": []}})"),
+            "D/sweep.json: shard.count: 0 is out of range (expected 1 <= count <= 1000000)");
+  EXPECT_EQ(message(head + R"({"index": 0, "count": 1, "point_ids": ["a", "b", "c", "d", "e"]}})"),
+            "D/sweep.json: shard.point_ids: 5 ids, more than the sweep's 4 points");
+  EXPECT_EQ(message(R"({"sweep_hash": 7, "plan_hash": "b"})"), "D/sweep.json: sweep_hash: expected a string, got number");
+  EXPECT_EQ(message("{"), "D/sweep.json: sweep.json: not JSON");
 }
 
 TEST(SweepRecords, ACorruptCompleteLineNamesFileAndLine) {
