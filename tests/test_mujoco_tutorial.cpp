@@ -7,12 +7,12 @@
 // defaults otherwise; first crossing of the tilt of e_Z through 90 deg, linearly interpolated):
 //   plain MuJoCo, tutorial XML from its keyframe                       3.527985607019 s
 //   bench, frame at O, the keyframe's state (v_O = 0, v_G = -d w_y e_X) 3.527985607019 s (2e-13 s off)
-//   bench, frame at O, the scene's state as shipped (v_G = 0)           3.441941319165 s (43 steps early)
+//   bench, frame at O, the scene's former state (v_G = 0)               3.441941319165 s (43 steps early)
 //   bench, frame at G, the scene's state (v_G = 0)                      0.705881171800 s
 //   bench, frame at G, the keyframe's state (v_G = -d w_y e_X)          0.711806715077 s
 // The frame decides MuJoCo's answer (3.5 s against 0.7 s for one body and one state); from the
-// ball-centre frame the answer also moves by 86 ms with the 5.4 mm/s of initial slip by which
-// the scene's start differs from the keyframe's (DISABLED_ case below).
+// ball-centre frame the answer also moves by 86 ms with 5.4 mm/s of initial slip (the scene's
+// start before it took the keyframe's velocity; the last case below checks the scene as shipped).
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
@@ -194,20 +194,17 @@ TEST(MujocoTutorial, BenchMatchesPlainMujocoFromTheKeyframeState) {
   EXPECT_NEAR(bench, plain, kTolerance);
 }
 
-// DISABLED: the scene as shipped does not start in the keyframe's state. mujoco_tutorial.toml
-// gives G zero velocity (initial.velocity = [0, 0]) with the keyframe's w = (0, 1, 200), so the
-// ball's centre starts sliding at v_O = w x (O - G) = (d w_y, 0, 0) = 5.43 mm/s, where the
-// keyframe has it at rest. In the ball-centre frame MuJoCo's inversion moves by 43 steps with
-// that: measured 3.441941 s against plain MuJoCo's 3.527986 s (86.0 ms early); with the
-// keyframe's velocity the bench gives 3.527986 s (the enabled case above). The difference is the
-// scene's initial state, not the adapter: enable when the scene's initial.velocity is the
-// keyframe's, [-d w_y, d w_x] = [-0.005431588728, 0].
-TEST(MujocoTutorial, DISABLED_BenchSceneAsShippedMatchesPlainMujoco) {
+// The scene as shipped starts in the keyframe's state: mujoco_tutorial.toml gives G the velocity
+// the keyframe implies (O at rest: v_G = w x (G - O) = (-d w_y, d w_x, 0) at tilt 0). It once gave
+// G zero velocity, so the ball's centre slid at 5.43 mm/s from the start, and MuJoCo in the
+// ball-centre frame inverted 43 steps early (3.441941 s against plain MuJoCo's 3.527986 s).
+TEST(MujocoTutorial, BenchSceneAsShippedMatchesPlainMujoco) {
   const Scene scene = load_scene(kScene, tutorial_settings("ball_centre"));
   const auto sim = make_mujoco_simulator(scene);
   const std::vector<double> qvel = mujoco_qvel(*sim);
-  // Fails today: qvel[0] = d w_y = 0.005431588728.
+  // The keyframe's qvel: O at rest (1e-15 as above).
   EXPECT_NEAR(qvel[0], 0.0, 1e-15);
+  EXPECT_NEAR(qvel[1], 0.0, 1e-15);
   const double plain = plain_inversion_time();
   const double bench = bench_inversion_time(scene);
   ASSERT_GT(plain, 0);
