@@ -204,6 +204,12 @@ struct ReferenceModel::Impl {
   EvFn pending_fn{EvKind::Inversion, 0};
   double pending_t = 0.0;
   bool stem_touched = false;
+  // Per slot, while it is off the floor: whether it left at rest (a release or a lift, not a
+  // bounce) and the highest gap seen at the check points since; `unresolved_noted`: the
+  // `unresolved` event has been recorded (once a run).
+  std::array<bool, 2> released_at_rest{false, false};
+  std::array<double, 2> flight_max_gap{0.0, 0.0};
+  bool unresolved_noted = false;
   double v_scale = 0.0, slip_eps = 0.0;
   double dt_hint = 0.0;
   std::string failure_hint;  // appended to a "non-finite state" failure: what to try instead
@@ -528,6 +534,11 @@ struct ReferenceModel::Impl {
       if (fns[i].kind == EvKind::Reversion) owner.events_.push_back({"reversion", te, "theta crosses 90 deg back", 0.0});
     }
     accumulate_friction_work(t0, best >= 0 ? best_t : t1);
+    for (size_t i = 0; i < fns.size(); ++i)
+      if (fns[i].kind == EvKind::Touchdown)
+        for (size_t k = 1; k < t_chk.size(); ++k)
+          if (t_chk[k] <= (best >= 0 ? best_t : t1))
+            flight_max_gap[fns[i].slot] = std::max(flight_max_gap[fns[i].slot], g_chk[k][i] - 1e-10 * dyn.body().R);
     for (size_t k = 1; k < t_chk.size(); ++k)
       if (t_chk[k] <= (best >= 0 ? best_t : t1)) track_graze(raw_chk[k]);
     if (best >= 0) {
@@ -792,6 +803,25 @@ struct ReferenceModel::Impl {
           owner.events_.push_back({"stem_contact", te, "first stem touchdown", removed});
         }
         ledger.impacts += removed;
+        // The excursion's height: the highest gap at the check points, or the height the
+        // return speed falls from under the gap acceleration at the return (the check
+        // points can miss the apex of a short excursion), whichever is larger.
+        double excursion = flight_max_gap[s];
+        if (released_at_rest[s] && !unresolved_noted) {
+          const double a = gap_acceleration(state_at(te), mode, s), vz = dyn.contact_velocity(x, s).z();
+          if (a < 0) excursion = std::max(excursion, vz * vz / (2 * -a));
+        }
+        if (released_at_rest[s] && excursion < kHoldApex * b.R && !unresolved_noted) {
+          // It left the floor at rest and comes back without having risen kHoldApex R: an
+          // excursion below what the integration resolves (here the gap is known to ~rtol of
+          // the body's size), so when it ends is not determined by the motion, and neither
+          // are the times of the events that follow from it. Recorded once, as a warning.
+          unresolved_noted = true;
+          std::ostringstream os;
+          os << "the " << slot_name(s) << " returns from an excursion below " << kHoldApex
+             << " R: its return, and the times of the events after it, are below the resolution";
+          owner.events_.push_back({"unresolved", te, os.str(), excursion});
+        }
         y = pack(post);
         // After the impact each touching contact is held (its normal velocity is 0 to the
         // round-off of the impact's solve), released (it separates), or, when the bounce it
@@ -855,6 +885,11 @@ struct ReferenceModel::Impl {
       default:
         break;
     }
+    for (int k = 0; k < 2; ++k)
+      if (!next.slot[k].active && (mode.slot[k].active || (fn.kind == EvKind::Touchdown && k == s))) {
+        released_at_rest[k] = fn.kind != EvKind::Touchdown;
+        flight_max_gap[k] = 0.0;
+      }
     set_mode(next, te);
     if (!mode.any_active() && !flight_allowed) return end(ReferenceStatus::ContactLost, te, "no contact can hold", y);
     restart(te, project_booked(y, te), first_dt);

@@ -14,12 +14,13 @@
 namespace tippe {
 
 struct ReferenceEvent {
-  std::string name;  // inversion, reversion, stem_contact, impact, hold, projection, switch,
+  std::string name;  // inversion, reversion, stem_contact, impact, hold, projection, unresolved, switch,
                      // two_contact, graze, lift, press, stick, slip, drill_stick, drill_slip,
                      // contact_lost, touchdown, flight, failed
   double time = 0.0;
   std::string detail;
-  double value = 0.0;  // impact, hold, projection: energy removed; switch: new surface code
+  double value = 0.0;  // impact, hold, projection: energy removed; switch: new surface code;
+                       // unresolved: the highest gap of the excursion
 };
 
 // Where the energy E0 - E(t) went, each term integrated or summed by the reference as it runs,
