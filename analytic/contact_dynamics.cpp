@@ -10,6 +10,7 @@
 #include "contact_dynamics.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 
 namespace tippe {
@@ -60,7 +61,50 @@ Vec3 ContactDynamics::contact_velocity(const BodyState& x, int slot) const {
   return x.v_WG + w_W.cross(geometry(x, slot).r_GC_W);
 }
 
+double ContactDynamics::gap_acceleration(const StateVector& y, const StateVector& dy, int slot) const {
+  const BodyState x = unpack(y, 0);
+  const Quat q = x.q_WB.normalized();
+  const Vec3 w_W = q * x.w_B, wdot_W = q * Vec3(dy[10], dy[11], dy[12]);
+  const Vec3 r_GO = geometry(x, slot).r_GO_W;
+  return dy[5] + wdot_W.cross(r_GO).z() + w_W.cross(w_W.cross(r_GO)).z();
+}
+
 ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode& mode, StateVector* dydt) const {
+  int grazing = -1, n_grazing = 0;
+  for (int s = 0; s < 2; ++s)
+    if (mode.slot[s].active && mode.slot[s].graze) {
+      grazing = s;
+      ++n_grazing;
+    }
+  if (n_grazing == 0) return evaluate_fixed(y, mode, dydt, 1.0);
+  // Filippov's combination of the lifted (share 0) and the loaded (share 1) fields; both are
+  // linear in the share, so the combination is the exact solution at the share found.
+  StateVector d0, d1;
+  const ContactForces f0 = evaluate_fixed(y, mode, &d0, 0.0), f1 = evaluate_fixed(y, mode, &d1, 1.0);
+  ContactForces out = f1;
+  out.solvable = f0.solvable && f1.solvable && n_grazing == 1;  // two grazing contacts: not a mode of this model
+  const int s = grazing;
+  const double a0 = gap_acceleration(y, d0, s), a1 = gap_acceleration(y, d1, s);
+  // a0 = a1 only where the slip (so the viscous force) vanishes: both fields agree there.
+  const double raw = a0 != a1 ? a0 / (a0 - a1) : (a0 < 0 ? 1.0 : 0.0);
+  const double f = std::clamp(raw, 0.0, 1.0);
+  out.graze_lifted_accel[s] = a0;
+  out.graze_loaded_accel[s] = a1;
+  out.graze_fraction_raw[s] = raw;
+  out.graze_fraction[s] = f;
+  for (int k = 0; k < 2; ++k) {
+    out.normal[k] = (1 - f) * f0.normal[k] + f * f1.normal[k];
+    out.force_W[k] = (1 - f) * f0.force_W[k] + f * f1.force_W[k];
+    out.drill_torque[k] = (1 - f) * f0.drill_torque[k] + f * f1.drill_torque[k];
+  }
+  out.normal[s] = 0.0;
+  if (dydt)
+    for (size_t i = 0; i < d0.size(); ++i) (*dydt)[i] = (1 - f) * d0[i] + f * d1[i];
+  return out;
+}
+
+ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const ContactMode& mode, StateVector* dydt,
+                                              double share) const {
   const BodyState x = unpack(y, 0.0);
   const double qn2 = x.q_WB.squaredNorm();
   const Quat q = x.q_WB.normalized();
@@ -78,7 +122,8 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
   Row rows[kMaxUnknowns];
   int n = 0;
   struct SlotIndex {
-    int normal = -1, tangential = -1, drill = -1, graze = -1;
+    int normal = -1, tangential = -1, drill = -1;
+    bool graze = false;
     Vec3 normal_dir = Vec3::UnitZ();
     double drill_coeff = 0.0;
   } idx[2];
@@ -112,12 +157,10 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
       fdir -= c_.mu * dir;
     }
     if (slot.graze) {
-      // Zero normal force; the unknown is the share of the viscous force that keeps the
-      // contact on the floor.
-      idx[s].graze = n;
-      cols[n] = {-c_.k * slip, r.cross(-c_.k * slip)};
-      ++n;
-      add_row(e_z);
+      // Zero normal force and the given share of the viscous force; no constraint.
+      idx[s].graze = true;
+      F_known += -share * c_.k * slip;
+      T_known += r.cross(-share * c_.k * slip);
       continue;
     }
     if (c_.friction == FrictionLaw::Viscous) {
@@ -193,9 +236,9 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
     T += cols[j].tau * u(j);
   }
   for (int s = 0; s < 2; ++s) {
-    if (idx[s].graze >= 0) {
-      out.graze_fraction[s] = u(idx[s].graze);
-      out.force_W[s] = -c_.k * u(idx[s].graze) * out.slip_W[s];
+    if (idx[s].graze) {
+      out.graze_fraction[s] = share;
+      out.force_W[s] = -share * c_.k * out.slip_W[s];
       continue;
     }
     if (idx[s].normal < 0) continue;
@@ -230,7 +273,9 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
 }
 
 BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touching, std::array<bool, 2>* kept,
-                                  std::array<double, 2>* normal_impulse, bool both_normal_only) const {
+                                  std::array<double, 2>* normal_impulse, Impulses kind) const {
+  const bool both_normal_only = kind == Impulses::Bilateral;
+  const bool normal_only = kind != Impulses::Impact;
   const Quat q = x.q_WB.normalized();
   const Eigen::Matrix3d R_WB = q.toRotationMatrix();
   const Vec3 I_B(m_.A, m_.A, m_.C);
@@ -248,7 +293,7 @@ BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touchi
   // Tangential impulses: rolling stops the whole contact velocity; Coulomb tries that and,
   // outside the cone, slides along the pre-impact slip; viscous and none have no impulsive
   // friction (a finite force transmits no impulse).
-  const bool full_stop = !both_normal_only && (c_.friction == FrictionLaw::Rolling || c_.friction == FrictionLaw::Coulomb);
+  const bool full_stop = !normal_only && (c_.friction == FrictionLaw::Rolling || c_.friction == FrictionLaw::Coulomb);
 
   struct Solution {
     bool ok = false;
@@ -309,8 +354,18 @@ BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touchi
 
   const std::array<std::array<bool, 2>, 3> sets = {{{true, false}, {false, true}, {true, true}}};
   Solution best;
+  if (kind == Impulses::Unilateral) {
+    // Nothing approaching: no impulse (the empty set solves the complementarity problem).
+    bool approaching = false;
+    for (int s = 0; s < 2; ++s) approaching = approaching || (touching[s] && v_pre[s].z() < 0);
+    if (!approaching) {
+      if (kept) *kept = {false, false};
+      if (normal_impulse) *normal_impulse = {0.0, 0.0};
+      return x;
+    }
+  }
   for (const auto& set : sets) {
-    if (both_normal_only && !(set[0] && set[1])) continue;
+    if (both_normal_only && set != touching) continue;
     if ((set[0] && !touching[0]) || (set[1] && !touching[1])) continue;
     std::array<bool, 2> sliding{false, false};
     Solution sol = solve(set, sliding);

@@ -23,7 +23,12 @@ struct ContactSlot {
   bool drill_stick = false;  // spin about the vertical held at zero (drilling friction sticking)
   // Viscous law only: the contact touches with zero normal force and carries the fraction
   // `graze_fraction` in [0, 1] of its viscous force that keeps it on the floor (Filippov's
-  // sliding mode between "held" and "lifted", see reference_model.cpp).
+  // sliding mode between "held" and "lifted", see reference_model.cpp). The motion is the
+  // convex combination (1 - f) "lifted" + f "loaded": lifted has no force at the contact,
+  // loaded its full viscous force and no normal force, the other contacts held in both; f
+  // makes the contact's gap acceleration zero. Both fields are solved on their own, so the
+  // fraction is defined (and clamped to [0, 1]) where its own linear system would be singular
+  // (the slip passing through 0, where both fields meet).
   bool graze = false;
   Vec3 slip_dir_W = Vec3::UnitX();  // Coulomb sliding direction used while |v_C| is ~0
 };
@@ -40,6 +45,12 @@ struct ContactForces {
   std::array<double, 2> drill_torque{0, 0};     // torque about +e_z at each contact
   std::array<double, 2> graze_fraction{1, 1};   // share of the viscous force of a grazing contact
   std::array<Vec3, 2> slip_W{Vec3::Zero(), Vec3::Zero()};   // horizontal velocity of the material point at C
+  // Grazing contacts only: the gap acceleration (of the contact sphere's centre) under the
+  // lifted and the loaded field, and the fraction a0 / (a0 - a1) before clamping. The graze
+  // is consistent while a0 <= 0 <= a1.
+  std::array<double, 2> graze_lifted_accel{0, 0};
+  std::array<double, 2> graze_loaded_accel{0, 0};
+  std::array<double, 2> graze_fraction_raw{1, 1};
   bool solvable = true;
 };
 
@@ -59,19 +70,36 @@ class ContactDynamics {
   // Velocity of the material point at the lowest point of a surface (lab frame).
   Vec3 contact_velocity(const BodyState& x, int slot) const;
 
-  // With both_normal_only, the impulses act at both contacts along the normal only and may have
-  // either sign: a projection of the velocity onto the two-contact constraint.
-  // Inelastic impact: impulses at the contacts in `touching` (slot flags) that leave no
-  // contact approaching the floor, with tangential impulses by the friction law. Returns the
-  // post-impact state (positions unchanged) and fills `post_mode_hint` with the contacts whose
-  // normal velocity is ~0 afterwards and that received an impulse.
+  // What the impulses of impact() may do.
+  enum class Impulses {
+    // A touchdown: inelastic impact of the contacts in `touching`, tangential impulses by the
+    // friction law, normal impulses >= 0 (the first of {ball}, {stem}, {both} that leaves no
+    // touching contact approaching the floor).
+    Impact,
+    // Unilateral projection onto the contacts in `touching`: normal impulses >= 0 only, that
+    // remove every approaching normal velocity and leave separating ones alone (the
+    // complementarity solution; no impulse at all when nothing approaches).
+    Unilateral,
+    // Bilateral projection onto the contacts in `touching`: normal impulses of either sign that
+    // zero their normal velocities with the smallest change of kinetic energy. Only for closing a Zeno
+    // cascade of impacts (see reference_model.cpp): there the pulling part stands for the
+    // finite forces acting over the skipped bounces, not for a contact force.
+    Bilateral,
+  };
+  // Post-impact state (positions unchanged). `kept` (may be null): the contacts whose normal
+  // velocity is ~0 afterwards; `normal_impulse`: the normal impulse per slot.
   BodyState impact(const BodyState& x, std::array<bool, 2> touching, std::array<bool, 2>* kept,
-                   std::array<double, 2>* normal_impulse, bool both_normal_only = false) const;
+                   std::array<double, 2>* normal_impulse, Impulses kind = Impulses::Impact) const;
+
+  // Acceleration of the centre of the contact sphere of `slot` along z, from a state derivative.
+  double gap_acceleration(const StateVector& y, const StateVector& dydt, int slot) const;
 
   const BodyModel& body() const { return m_; }
   const ContactSpec& contact() const { return c_; }
 
  private:
+  // evaluate() with every grazing contact carrying the fixed share `share` of its viscous force.
+  ContactForces evaluate_fixed(const StateVector& y, const ContactMode& mode, StateVector* dydt, double share) const;
   BodyModel m_;
   ContactSpec c_;
 };

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "contact_dynamics.h"
@@ -13,11 +14,24 @@
 namespace tippe {
 
 struct ReferenceEvent {
-  std::string name;  // inversion, reversion, stem_contact, impact, switch, two_contact, stick,
-                     // slip, drill_stick, drill_slip, contact_lost, touchdown, flight
+  std::string name;  // inversion, reversion, stem_contact, impact, hold, projection, unresolved, switch,
+                     // two_contact, graze, lift, press, stick, slip, drill_stick, drill_slip,
+                     // contact_lost, touchdown, flight, failed
   double time = 0.0;
   std::string detail;
-  double value = 0.0;  // impact: energy removed; switch: new surface code
+  double value = 0.0;  // impact, hold, projection: energy removed; switch: new surface code;
+                       // unresolved: the highest gap of the excursion
+};
+
+// Where the energy E0 - E(t) went, each term integrated or summed by the reference as it runs,
+// so that E(t) + total() = E0 up to the integration error.
+struct EnergyLedger {
+  double friction = 0.0;     // work done against the contact forces: -int sum_s F_s . v_C + tau_s w_z dt
+  double impacts = 0.0;      // removed by touchdown impacts (the impact events' values)
+  double holds = 0.0;        // removed where a Zeno cascade of impacts is closed (hold events)
+  double projections = 0.0;  // removed by the two-contact projection at restarts (projection events)
+  double drift = 0.0;        // changed by the one-contact drift correction at restarts (tolerance-sized)
+  double total() const { return friction + impacts + holds + projections + drift; }
 };
 
 enum class ReferenceStatus { Ok, ContactLost, Failed };
@@ -44,6 +58,17 @@ class ReferenceModel {
   ReferenceStatus status() const { return status_; }
   double status_time() const { return status_time_; }
   const std::string& status_detail() const { return status_detail_; }
+  // The ledger at the observed time.
+  EnergyLedger energy_ledger() const;
+  // Smallest and largest graze fraction (as the motion uses it) met while a contact grazed, at
+  // every point of the motion the reference evaluated (check points up to an event, event
+  // times, restarts); {+inf, -inf} when no contact grazed.
+  std::pair<double, double> graze_fraction_range() const;
+  // Largest amount, at those points, by which a grazing contact's neighbouring fields were
+  // consistent themselves: max(a0, -a1) (gap accelerations of the lifted and the loaded
+  // field), 0 while the graze is a true sliding mode. The fraction a0 / (a0 - a1) before
+  // clamping leaves [0, 1] exactly where this is > 0.
+  double graze_violation() const;
   long long steps() const { return steps_; }
   long long rhs_evaluations() const { return rhs_evals_; }
   const BodyModel& body() const { return body_; }
