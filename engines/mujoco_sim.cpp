@@ -63,11 +63,15 @@ struct MujocoSettings {
   double rolling_mu = 1e3;
   // Where the free body's frame (and so its joint) has its origin: a modelling choice, not
   // physics, yet MuJoCo 2.2.2's answer depends on it (BENCHMARKS.md, "MuJoCo's body frame").
-  // "com": at the centre of mass G, principal axes (the bench's first choice); "ball_centre": at
-  // the ball's centre O, as MuJoCo's tutorial top and most hand-written models have it. The
-  // default stays "com" so that every published MuJoCo number keeps its meaning; every verdict
-  // on MuJoCo names the frame, and the modelling sweep runs both.
-  std::string body_frame = "com";
+  // MuJoCo applies its soft-constraint law to J qacc and never computes J-dot qvel
+  // (mj_fwdConstraint: efc_b = J qacc_smooth - aref); for a free joint that omitted term depends
+  // on the frame origin. "ball_centre" (the default): the origin at the ball's centre O, where the
+  // term is exactly zero for a sphere on a plane, so MuJoCo's contact law acts on the true gap and
+  // slip; it is also the frame of MuJoCo's tutorial top and of most hand-written models.
+  // "com": the origin at the centre of mass G (the bench's first choice), where the omitted
+  // term, d w3 |w_perp| in the friction rows (1.8 m/s^2 on the toy top), holds a false slip that
+  // turns Coulomb tops over ten times early.
+  std::string body_frame = "ball_centre";
 
   template <class V>
   void visit(V& v) {
@@ -548,6 +552,7 @@ MujocoModelReadback MujocoSimulator::readback() const {
   r.inertia = Vec3(m_->body_inertia[3 * b], m_->body_inertia[3 * b + 1], m_->body_inertia[3 * b + 2]);
   r.iquat_B = Quat(m_->body_iquat[4 * b], m_->body_iquat[4 * b + 1], m_->body_iquat[4 * b + 2], m_->body_iquat[4 * b + 3]);
   r.timestep = m_->opt.timestep;
+  r.frame_origin_G = Vec3(0.0, 0.0, frame_z_);
   r.nq = m_->nq;
   r.nv = m_->nv;
   return r;

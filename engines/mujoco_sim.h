@@ -16,6 +16,9 @@ struct MujocoModelReadback {
   Vec3 inertia = Vec3::Zero();
   Quat iquat_B = Quat::Identity();
   double timestep = 0.0;
+  // Where the body frame's origin is in the principal frame at G: 0 (body_frame "com") or d e_Z
+  // (the ball's centre, "ball_centre"); ipos_B + frame_origin_G is the centre of mass about G.
+  Vec3 frame_origin_G = Vec3::Zero();
   int nq = 0, nv = 0;
 };
 

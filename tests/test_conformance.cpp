@@ -46,7 +46,8 @@ Held held_mass(const std::string& engine, const Simulator& sim, const Scene& s) 
   }
   if (engine == "mujoco") {
     const MujocoModelReadback r = mujoco_model_readback(sim);
-    return {r.mass, r.ipos_B, r.inertia};
+    // The centre of mass about G: MuJoCo's body_ipos is about the body frame's origin.
+    return {r.mass, r.ipos_B + r.frame_origin_G, r.inertia};
   }
   if (engine == "bullet") {
     const BulletReadback r = bullet_readback(sim);

@@ -98,9 +98,11 @@ TEST(Mujoco, MassReadBackEqualsScene) {
   EXPECT_NEAR(r.inertia.x(), A, 1e-12 * A);
   EXPECT_NEAR(r.inertia.y(), A, 1e-12 * A);
   EXPECT_NEAR(r.inertia.z(), C, 1e-12 * C);
-  // The body frame origin is G: the centre of mass offset must vanish (to 1e-12 R) and the
-  // principal axes must be the body axes (so that inertia.z is about e_Z).
-  EXPECT_LE(r.ipos_B.norm(), 1e-12 * scene.body.sphere_radius);
+  // The body frame's origin is the ball's centre O (the default body_frame), G at -d e_Z from it:
+  // the centre of mass about G must vanish (to 1e-12 R) and the principal axes must be the body
+  // axes (so that inertia.z is about e_Z).
+  EXPECT_LE((r.ipos_B + r.frame_origin_G).norm(), 1e-12 * scene.body.sphere_radius);
+  EXPECT_NEAR(r.frame_origin_G.z(), scene.mass.com_offset, 1e-15);
   EXPECT_LE(r.iquat_B.angularDistance(Quat::Identity()), 1e-12);
   EXPECT_EQ(r.nq, 7);
   EXPECT_EQ(r.nv, 6);
