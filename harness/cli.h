@@ -34,7 +34,10 @@ using Setup = Command (*)(CLI::App& app);
 // A subcommand's exception as an exit code, its message on stderr when `print`: bad input
 // (SceneError, UsageError) and an unusable output path (OutputError) -> 2; a signal that ended
 // the command cleanly (Interrupted) -> 128 + its number, as a shell reports a signal; anything
-// else is a bug -> 1, said as "internal".
+// else is a bug -> kInternalExit, said as "internal". 1 is a failing gate's alone, so that CI can
+// tell "the settings fail" from "tippe broke".
+inline constexpr int kInternalExit = 3;
+
 inline int error_exit(const std::exception_ptr& e, bool print = true) {
   try {
     std::rethrow_exception(e);
@@ -52,7 +55,7 @@ inline int error_exit(const std::exception_ptr& e, bool print = true) {
     return 128 + x.signal();
   } catch (const std::exception& x) {
     if (print) std::cerr << "tippe: error: internal: " << x.what() << "\n";
-    return 1;
+    return kInternalExit;
   }
 }
 
