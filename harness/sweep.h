@@ -324,8 +324,10 @@ struct ChoiceEffect {
   std::optional<double> reference_inversion;  // the reference's, on this scene
   size_t steps = 0;                 // steps at which two or more values ran
   bool regime_moves = false;
-  std::string regime_at;                      // the first step at which the regime differs
-  std::vector<std::string> regime_outcomes;   // there, "VALUE: OUTCOME" for each value
+  size_t regime_steps = 0;                    // steps at which the regime differs
+  std::string regime_at;                      // the first of them
+  std::vector<std::string> regime_outcomes;   // there, "VALUE: OUTCOME" for each value ("in the
+                                              // reference's regime" added where it is)
   std::optional<double> largest_spread;       // over the steps where two or more invert
   std::string spread_at;                      // the step of the largest spread
   std::vector<std::string> spread_times;      // there, "VALUE T" for each value that inverts

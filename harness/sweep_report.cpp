@@ -818,8 +818,16 @@ std::string join_list(const std::vector<std::string>& v, const char* sep) {
   return t;
 }
 
+// "at STEP" of the first step at which the regime differs, and at how many it does.
+std::string regime_where(const ChoiceEffect& e) {
+  if (e.regime_at.empty()) return "";
+  if (e.steps > 1 && e.regime_steps == e.steps) return "at every step (" + std::to_string(e.steps) + ")";
+  return "at " + e.regime_at +
+         (e.steps > 1 ? " (" + std::to_string(e.regime_steps) + " of " + std::to_string(e.steps) + " steps)" : "");
+}
+
 std::string choice_detail(const ChoiceEffect& e) {
-  const std::string at_regime = e.regime_at.empty() ? "" : "at " + e.regime_at + ": ";
+  const std::string at_regime = e.regime_at.empty() ? "" : regime_where(e) + ": ";
   const std::string at_spread = e.spread_at.empty() ? "" : " at " + e.spread_at;
   std::string spread = e.largest_spread ? "inversion times " + spread_text(*e.largest_spread) + " apart" + at_spread + " (" +
                                               join_list(e.spread_times, ", ") + ")"
@@ -860,7 +868,7 @@ void choices_section(const std::vector<SweepRecord>& records, std::vector<Block>
         if (e.engine != engine || e.key != key) continue;
         const std::string where = e.scene + (e.setup.empty() ? "" : " (" + e.setup + ")");
         if (e.regime_moves)
-          moves.push_back(where + ": the regime" + (e.regime_at.empty() ? "" : " at " + e.regime_at) +
+          moves.push_back(where + ": the regime" + (e.regime_at.empty() ? "" : " " + regime_where(e)) +
                           (e.time_moves() ? ", and the inversion time by " + spread_text(*e.largest_spread) : ""));
         else if (e.time_moves())
           moves.push_back(where + ": the inversion time by " + spread_text(*e.largest_spread) +
@@ -1021,12 +1029,15 @@ std::vector<ChoiceEffect> modelling_choices(const std::vector<SweepRecord>& reco
             kinds.insert(2);
             what = r->status + " at " + fmt("%.4g", r->status_time);
           }
-          outcomes.push_back(choice(*r) + ": " + what);
+          outcomes.push_back(choice(*r) + ": " + what + (agrees_with_reference_regime(*r) ? " (the reference's regime)" : ""));
         }
-        if (kinds.size() > 1 && !e.regime_moves) {
+        if (kinds.size() > 1) {
+          if (!e.regime_moves) {
+            e.regime_at = step_text[k];
+            e.regime_outcomes = outcomes;
+          }
           e.regime_moves = true;
-          e.regime_at = step_text[k];
-          e.regime_outcomes = outcomes;
+          ++e.regime_steps;
         }
         if (times.size() >= 2 && lo > 0) {
           const double spread = (hi - lo) / lo;

@@ -871,7 +871,9 @@ TEST(SweepLadders, ModellingChoicesFindWhatMovesTheVerdict) {
   EXPECT_EQ(frame.steps, 2u);
   EXPECT_TRUE(frame.regime_moves);
   EXPECT_EQ(frame.regime_at, "timestep = 0.001");
-  EXPECT_EQ(frame.regime_outcomes, (std::vector<std::string>{"com: inverts at 4", "ball_centre: does not invert"}));
+  EXPECT_EQ(frame.regime_steps, 1u);
+  EXPECT_EQ(frame.regime_outcomes,
+            (std::vector<std::string>{"com: inverts at 4 (the reference's regime)", "ball_centre: does not invert"}));
   EXPECT_TRUE(frame.moves());
   const ChoiceEffect& cone = effects[1];
   EXPECT_FALSE(cone.regime_moves);
@@ -887,13 +889,13 @@ TEST(SweepLadders, ModellingChoicesFindWhatMovesTheVerdict) {
 
   const std::string md = render_sweep_markdown(recs);
   EXPECT_NE(md.find("## Modelling choices"), std::string::npos) << md;
-  EXPECT_NE(md.find("mujoco: body_frame moves it (s (body_frame): the regime at timestep = 0.001). cone moves it (s "
+  EXPECT_NE(md.find("mujoco: body_frame moves it (s (body_frame): the regime at timestep = 0.001 (1 of 2 steps)). cone moves it (s "
                     "(cone): the inversion time by 5 % at timestep = 0.0005). noslip_iterations does not move the "
                     "verdict (s (noslip_iterations): within 0.5 %)."),
             std::string::npos)
       << md;
   EXPECT_NE(md.find("| mujoco | s | inverts at 10 | body_frame | engines.mujoco.body_frame | com, ball_centre | moves the regime | at "
-                    "timestep = 0.001: com: inverts at 4; ball_centre: does not invert;"),
+                    "timestep = 0.001 (1 of 2 steps): com: inverts at 4 (the reference's regime); ball_centre: does not invert;"),
             std::string::npos)
       << md;
   EXPECT_NE(md.find("| moves the inversion time by 5 % | largest: inversion times 5 % apart at timestep = 0.0005 "
