@@ -121,12 +121,69 @@ class SweepReader {
     return *t;
   }
 
-  // A ladder value as the TOML text an override needs: integers stay integers (iteration
-  // counts), floats keep the shortest text that reads back to the same double.
-  std::string value_text(const toml::node& n, const std::string& key, double& value) const {
+  // An axis value as the TOML text an override needs: integers stay integers (iteration
+  // counts), floats keep the shortest text that reads back to the same double, strings (which
+  // follow the rule of names, so need no escape) are quoted, booleans are true or false. `label`
+  // is the text a record carries, `value` the number (NaN for a string or a boolean).
+  std::string value_text(const toml::node& n, const std::string& key, double& value, std::string& label) const {
+    value = std::numeric_limits<double>::quiet_NaN();
+    if (const auto* str = n.as_string()) {
+      label = str->get();
+      if (!is_valid_name(label))
+        fail(key, "\"" + utf8_replaced(label.substr(0, 40)) + "\" is not a usable value (" + kNameRule +
+                      "; it becomes a report label)");
+      return "\"" + label + "\"";
+    }
+    if (const auto* b = n.as_boolean()) return label = b->get() ? "true" : "false";
+    if (!n.is_number()) fail(key, "expected a number, a string or a boolean, got " + toml_value_text(n));
     value = number(n, key);
-    if (const auto* i = n.as_integer()) return std::to_string(i->get());
-    return json(value).dump();
+    if (const auto* i = n.as_integer()) return label = std::to_string(i->get());
+    return label = json(value).dump();
+  }
+
+  // `ladder` or `grid` of a setup: {key, values}. Every value adds `per_value` points to
+  // `planned`, refused beyond kMaxSweepPoints before anything is loaded.
+  void read_axis(const toml::node& node, const std::string& where, const std::string& engine,
+                 const std::set<std::string>& set_keys, std::string& axis_key, std::vector<double>& values,
+                 std::vector<std::string>& texts, std::vector<std::string>& labels, size_t scenes, size_t per_value,
+                 size_t& planned) const {
+    const toml::table& l = table(node, where);
+    keys(l, where, {"key", "values"});
+    const toml::node* lk = l.get("key");
+    if (!lk) fail(where + ".key", "missing (required)");
+    axis_key = trim(string(*lk, where + ".key"));
+    check_setting_key(engine, axis_key, where + ".key");
+    const std::string setup = where.substr(0, where.rfind('.'));
+    if (set_keys.count(axis_key)) fail(where + ".key", axis_key + " is also fixed in " + setup + ".set");
+    const toml::node* lv = l.get("values");
+    if (!lv) fail(where + ".values", "missing (required)");
+    const toml::array& a = array(*lv, where + ".values");
+    if (a.empty()) fail(where + ".values", "must list at least one value");
+    const auto kind = [](const toml::node& n) { return n.is_string() ? "a string" : n.is_boolean() ? "a boolean" : "a number"; };
+    for (size_t j = 0; j < a.size(); ++j) {
+      const std::string vk = idx(where + ".values", j);
+      // The plan's size is known from the file alone: refused here, before a single point is
+      // loaded (and before the quadratic check of distinct values runs over a huge ladder).
+      planned += per_value;
+      if (scenes * planned > kMaxSweepPoints)
+        fail(vk, std::to_string(scenes) + " scene(s) x " + std::to_string(planned) +
+                     (per_value == 1 ? " ladder value(s)" : " point(s) per scene") + " so far is more than " +
+                     std::to_string(kMaxSweepPoints) +
+                     " points, the most a sweep plans; split it into several sweep files");
+      const toml::node& n = *a.get(j);
+      double v;
+      std::string label;
+      const std::string vt = value_text(n, vk, v, label);
+      if (j > 0 && std::string(kind(n)) != kind(*a.get(0)))
+        fail(vk, "expected " + std::string(kind(*a.get(0))) + " like " + idx(where + ".values", 0) + ", got " +
+                     toml_value_text(n) + " (an axis' values are all numbers, all strings or all booleans)");
+      for (size_t m = 0; m < values.size(); ++m)
+        if (std::isnan(v) ? texts[m] == vt : values[m] == v)
+          fail(vk, (std::isnan(v) ? label : num(v)) + " repeats " + idx(where + ".values", m));
+      values.push_back(v);
+      texts.push_back(vt);
+      labels.push_back(label);
+    }
   }
 
   SweepSpec read(const toml::table& root, const std::string& text) const {
@@ -190,7 +247,7 @@ class SweepReader {
     for (size_t i = 0; i < setups.size(); ++i) {
       const std::string key = idx("setup", i);
       const toml::table& t = table(*setups.get(i), key);
-      keys(t, key, {"name", "engine", "set", "ladder"});
+      keys(t, key, {"name", "engine", "set", "ladder", "grid"});
       SweepSetup u;
       const toml::node* name = t.get("name");
       if (!name) fail(key + ".name", "missing (required)");
@@ -224,31 +281,14 @@ class SweepReader {
       }
       const toml::node* ladder = t.get("ladder");
       if (!ladder) fail(key + ".ladder", "missing (required: {key = \"...\", values = [...]})");
-      const toml::table& l = table(*ladder, key + ".ladder");
-      keys(l, key + ".ladder", {"key", "values"});
-      const toml::node* lk = l.get("key");
-      if (!lk) fail(key + ".ladder.key", "missing (required)");
-      u.ladder_key = trim(string(*lk, key + ".ladder.key"));
-      check_setting_key(u.engine, u.ladder_key, key + ".ladder.key");
-      if (set_keys.count(u.ladder_key)) fail(key + ".ladder.key", u.ladder_key + " is also fixed in " + key + ".set");
-      const toml::node* lv = l.get("values");
-      if (!lv) fail(key + ".ladder.values", "missing (required)");
-      const toml::array& values = array(*lv, key + ".ladder.values");
-      if (values.empty()) fail(key + ".ladder.values", "must list at least one value");
-      for (size_t j = 0; j < values.size(); ++j) {
-        const std::string vk = idx(key + ".ladder.values", j);
-        // The plan's size is known from the file alone: refused here, before a single point is
-        // loaded (and before the quadratic check of distinct values runs over a huge ladder).
-        if (s.scenes.size() * ++planned > kMaxSweepPoints)
-          fail(vk, std::to_string(s.scenes.size()) + " scene(s) x " + std::to_string(planned) +
-                       " ladder value(s) so far is more than " + std::to_string(kMaxSweepPoints) +
-                       " points, the most a sweep plans; split it into several sweep files");
-        double v;
-        const std::string vt = value_text(*values.get(j), vk, v);
-        for (size_t m = 0; m < u.ladder_values.size(); ++m)
-          if (u.ladder_values[m] == v) fail(vk, num(v) + " repeats " + idx(key + ".ladder.values", m));
-        u.ladder_values.push_back(v);
-        u.ladder_texts.push_back(vt);
+      read_axis(*ladder, key + ".ladder", u.engine, set_keys, u.ladder_key, u.ladder_values, u.ladder_texts,
+                u.ladder_labels, s.scenes.size(), 1, planned);
+      if (const toml::node* grid = t.get("grid")) {
+        // Each grid value beyond the first adds the ladder's points again.
+        planned -= u.ladder_values.size();
+        read_axis(*grid, key + ".grid", u.engine, set_keys, u.grid_key, u.grid_values, u.grid_texts, u.grid_labels,
+                  s.scenes.size(), u.ladder_values.size(), planned);
+        if (u.grid_key == u.ladder_key) fail(key + ".grid.key", u.grid_key + " is also " + key + "'s ladder key");
       }
       s.setups.push_back(u);
     }
@@ -312,13 +352,19 @@ std::string fnv1a_hex(const std::vector<std::string>& parts) {
 }
 
 std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& setup, const std::string& value_text,
-                           int repeats) {
+                           int repeats, const std::string& grid_value_text) {
   std::vector<std::string> parts = {"tippe-sweep-point-1", physics_hash, setup.name, setup.engine};
   parts.push_back(std::to_string(setup.set.size()));
   for (const auto& s : setup.set) parts.push_back(s);
   parts.push_back(setup.ladder_key);
   parts.push_back(value_text);
   parts.push_back(std::to_string(repeats));
+  // After everything a one-axis id hashes, so that those stay what they were.
+  if (setup.has_grid()) {
+    parts.push_back("grid");
+    parts.push_back(setup.grid_key);
+    parts.push_back(grid_value_text);
+  }
   return fnv1a_hex(parts);
 }
 
@@ -385,21 +431,40 @@ SweepPlan load_sweep(const std::string& path) {
         const auto j = override_named(x, file, setup.set);
         reader.fail(j ? idx(key + ".set", *j) : key + ".set", quote_scene_error(x, file));
       }
-      for (size_t k = 0; k < setup.ladder_values.size(); ++k) {
-        std::vector<std::string> point_over = over;
-        point_over.push_back(setup.ladder_key + "=" + setup.ladder_texts[k]);
-        SweepPoint p;
-        p.scene_index = i;
-        p.setup_index = u;
-        p.ladder_index = k;
+      // A grid value the engine refuses is named as the grid's, whatever the ladder value.
+      for (size_t g = 0; g < setup.grid_values.size(); ++g) {
+        std::vector<std::string> grid_over = over;
+        grid_over.push_back(setup.grid_key + "=" + setup.grid_texts[g]);
         try {
-          p.scene = load_scene(file, point_over);
+          load_scene(file, grid_over);
         } catch (const SceneError& x) {
-          reader.fail(idx(key + ".ladder.values", k), quote_scene_error(x, file));
+          reader.fail(idx(key + ".grid.values", g), quote_scene_error(x, file));
         }
-        p.id = sweep_point_id(plan.physics_hashes[i], setup, setup.ladder_texts[k], s.repeats);
-        ids.push_back(p.id);
-        plan.points.push_back(std::move(p));
+      }
+      const size_t grid_count = setup.has_grid() ? setup.grid_values.size() : 1;
+      for (size_t g = 0; g < grid_count; ++g) {
+        for (size_t k = 0; k < setup.ladder_values.size(); ++k) {
+          std::vector<std::string> point_over = over;
+          point_over.push_back(setup.ladder_key + "=" + setup.ladder_texts[k]);
+          if (setup.has_grid()) point_over.push_back(setup.grid_key + "=" + setup.grid_texts[g]);
+          SweepPoint p;
+          p.scene_index = i;
+          p.setup_index = u;
+          p.ladder_index = k;
+          p.grid_index = g;
+          try {
+            p.scene = load_scene(file, point_over);
+          } catch (const SceneError& x) {
+            reader.fail(idx(key + ".ladder.values", k) +
+                            (setup.has_grid() ? " (with " + idx(key + ".grid.values", g) + ")" : std::string()),
+                        quote_scene_error(x, file));
+          }
+          p.id = setup.has_grid()
+                     ? sweep_point_id(plan.physics_hashes[i], setup, setup.ladder_texts[k], s.repeats, setup.grid_texts[g])
+                     : sweep_point_id(plan.physics_hashes[i], setup, setup.ladder_texts[k], s.repeats);
+          ids.push_back(p.id);
+          plan.points.push_back(std::move(p));
+        }
       }
     }
   }
@@ -469,6 +534,36 @@ class RecordReader {
     if (x < lo || x > hi) fail(k, v.dump() + " is out of range (expected " + range + ")");
     return x;
   }
+  // A setting key ("engines.ode.timestep"): the rule of names, as it reaches report labels.
+  static std::string key(const json& j, const std::string& prefix, const char* k) {
+    const std::string v = string(j, prefix, k);
+    if (!is_valid_name(v))
+      fail(dotted(prefix, k), "\"" + utf8_replaced(v.substr(0, 40)) + "\" is not a usable key (" + kNameRule + ")");
+    return v;
+  }
+  // An axis value as text: a name or a number; the number of `value` (NaN: none) when it is one.
+  static std::string label(const json& j, const std::string& prefix, const char* k, double value,
+                           const char* value_key) {
+    const std::string v = string(j, prefix, k);
+    const std::string where = dotted(prefix, k);
+    const std::string shown = "\"" + utf8_replaced(v.substr(0, 40)) + "\"";
+    const std::optional<double> x = number_text_value(v);
+    if (!x && !is_valid_name(v)) fail(where, shown + " is neither a number nor a usable name (" + kNameRule + ")");
+    if (!std::isnan(value) && (!x || *x != value))
+      fail(where, shown + " is not " + value_key + " " + num(value));
+    if (std::isnan(value) && x) fail(where, shown + " is a number, but " + value_key + " is null");
+    return v;
+  }
+  // The number a text is, all of it, finite; nullopt otherwise.
+  static std::optional<double> number_text_value(const std::string& v) {
+    if (v.empty() || v.size() > 40) return std::nullopt;
+    char* end = nullptr;
+    const double x = std::strtod(v.c_str(), &end);
+    if (end != v.c_str() + v.size() || !std::isfinite(x)) return std::nullopt;
+    // strtod reads "inf", "nan", hex and leading blanks; a label is none of those.
+    if (v.find_first_not_of("0123456789+-.eE") != std::string::npos) return std::nullopt;
+    return x;
+  }
   // One of `names`.
   static std::string name(const json& j, const std::string& prefix, const char* key,
                           std::initializer_list<const char*> names) {
@@ -525,8 +620,15 @@ json to_json(const SweepRecord& r) {
       {"set", r.set},
       {"ladder_key", r.ladder_key},
       {"ladder_value", number(r.ladder_value)},
+      {"ladder_label", !r.ladder_label.empty() || !std::isfinite(r.ladder_value) ? r.ladder_label
+                                                                                 : json(r.ladder_value).dump()},
       {"setup_index", r.setup_index},
       {"ladder_index", r.ladder_index},
+      {"grid", r.grid_key.empty() ? json(nullptr)
+                                  : json{{"key", r.grid_key},
+                                         {"value", number(r.grid_value)},
+                                         {"label", r.grid_label},
+                                         {"index", r.grid_index}}},
       {"repeats", r.repeats},
       {"duration", number(r.duration)},
       {"status", r.status},
@@ -577,10 +679,24 @@ SweepRecord sweep_record_from_json(const json& j) {
     if (!set[i].is_string()) R::fail("set[" + std::to_string(i) + "]", std::string("expected a string, got ") + set[i].type_name());
     r.set.push_back(set[i].get<std::string>());
   }
-  r.ladder_key = R::string(j, "", "ladder_key");
+  r.ladder_key = R::key(j, "", "ladder_key");
   r.ladder_value = R::number(j, "", "ladder_value");
+  // Records from before categorical ladders carry only the number.
+  if (j.contains("ladder_label"))
+    r.ladder_label = R::label(j, "", "ladder_label", r.ladder_value, "ladder_value");
+  else if (std::isnan(r.ladder_value))
+    R::fail("ladder_label", "missing (required when ladder_value is null)");
+  else
+    r.ladder_label = json(r.ladder_value).dump();
   r.setup_index = R::integer(j, "", "setup_index", 0, max_index);
   r.ladder_index = R::integer(j, "", "ladder_index", 0, max_index);
+  if (j.contains("grid") && !j.at("grid").is_null()) {
+    const json& g = j.at("grid");
+    r.grid_key = R::key(g, "grid", "key");
+    r.grid_value = R::number(g, "grid", "value");
+    r.grid_label = R::label(g, "grid", "label", r.grid_value, "grid.value");
+    r.grid_index = R::integer(g, "grid", "index", 0, max_index);
+  }
   r.repeats = R::integer(j, "", "repeats", 1, kMaxRepeats);
   r.duration = R::number(j, "", "duration", 0.0);
   // Any status reads (a newer build's reads with the class "failed" when no class is written); the
@@ -907,8 +1023,15 @@ SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Referenc
   r.set = setup.set;
   r.ladder_key = setup.ladder_key;
   r.ladder_value = setup.ladder_values[p.ladder_index];
+  r.ladder_label = setup.ladder_labels[p.ladder_index];
   r.setup_index = static_cast<long long>(p.setup_index);
   r.ladder_index = static_cast<long long>(p.ladder_index);
+  if (setup.has_grid()) {
+    r.grid_key = setup.grid_key;
+    r.grid_value = setup.grid_values[p.grid_index];
+    r.grid_label = setup.grid_labels[p.grid_index];
+    r.grid_index = static_cast<long long>(p.grid_index);
+  }
   r.repeats = plan.spec.repeats;
   r.duration = p.scene.run.duration;
   r.reference_inversion_time = ref.record.inversion_time;
@@ -982,11 +1105,13 @@ SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Referenc
 // progress line scales it by the seconds per unit measured on that setup's finished points.
 double point_weight(const SweepPlan& plan, const SweepPoint& p) {
   const SweepSetup& s = plan.spec.setups[p.setup_index];
-  const double v = s.ladder_values[p.ladder_index];
-  const double per_time =
-      s.ladder_key.size() >= 8 && s.ladder_key.compare(s.ladder_key.size() - 8, 8, "timestep") == 0 && v > 0
-          ? 1.0 / v
-          : (s.engine == "analytic" ? 100.0 : 1e4);
+  const auto is_step = [](const std::string& k) {
+    return k.size() >= 8 && k.compare(k.size() - 8, 8, "timestep") == 0;
+  };
+  // The time step may be either axis of a grid.
+  double v = is_step(s.ladder_key) ? s.ladder_values[p.ladder_index] : std::nan("");
+  if (s.has_grid() && is_step(s.grid_key)) v = s.grid_values[p.grid_index];
+  const double per_time = v > 0 ? 1.0 / v : (s.engine == "analytic" ? 100.0 : 1e4);
   return plan.spec.repeats * p.scene.run.duration * per_time;
 }
 
@@ -1315,7 +1440,8 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<O
     const SweepPoint& p = plan.points[it->second];
     for (const auto& [key, got, want] :
          {std::make_tuple("scene_index", r.scene_index, p.scene_index), std::make_tuple("setup_index", r.setup_index, p.setup_index),
-          std::make_tuple("ladder_index", r.ladder_index, p.ladder_index)})
+          std::make_tuple("ladder_index", r.ladder_index, p.ladder_index),
+          std::make_tuple("grid.index", r.grid_index, p.grid_index)})
       if (got != static_cast<long long>(want))
         throw SweepInputError(where + key + ": " + std::to_string(got) + " is not point " + r.point_id + "'s (" +
                               std::to_string(want) + " in the plan); give --restart to begin the directory again");

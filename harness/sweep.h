@@ -25,13 +25,33 @@ struct SweepScene {
   std::optional<double> duration;  // this scene's own override of run.duration
 };
 
-// One [[setup]]: an engine, fixed overrides, and the key swept over `values`.
+// One [[setup]]: an engine, fixed overrides, the key swept over `values`, and optionally a
+// second key (a grid: every ladder value with every grid value).
+//
+// The file form is two tables, not an array of axes:
+//   ladder = { key = "engines.mujoco.timestep", values = [1e-3, 5e-4] }
+//   grid   = { key = "engines.mujoco.body_frame", values = ["com", "ball_centre"] }
+// because the two axes play different parts: the ladder is walked along (a work-precision line,
+// a convergence order, the softest setting still in the reference's regime), the grid picks the
+// line (one line per grid value, and the "Modelling choices" comparison across them at each
+// ladder value). `ladder = [{...}, {...}]` would leave which is which to the order of the
+// entries; with two names, a one-axis file reads exactly as before and a grid says what it does.
+// Values of either axis are all numbers, all strings or all booleans (a categorical axis:
+// `values = ["com", "ball_centre"]`); strings follow the rule of names (is_valid_name), since
+// they become report labels.
 struct SweepSetup {
   std::string name, engine;
   std::vector<std::string> set;  // "KEY=VALUE" overrides, as written
   std::string ladder_key;
-  std::vector<double> ladder_values;
-  std::vector<std::string> ladder_texts;  // each value as a TOML value (integers stay integers)
+  std::vector<double> ladder_values;      // NaN for a value that is not a number
+  std::vector<std::string> ladder_texts;  // each value as a TOML value (integers stay integers, strings quoted)
+  std::vector<std::string> ladder_labels;  // each value as records carry it (the text, strings unquoted)
+  std::string grid_key;                    // the second axis; empty: a one-axis ladder
+  std::vector<double> grid_values;         // as the ladder's
+  std::vector<std::string> grid_texts, grid_labels;
+  bool has_grid() const { return !grid_key.empty(); }
+  // Points of this setup: ladder values times grid values (1 without a grid).
+  size_t point_count() const { return ladder_values.size() * (has_grid() ? grid_values.size() : 1); }
 };
 
 struct SweepSpec {
@@ -48,6 +68,7 @@ struct SweepSpec {
 // One run of a sweep: a scene with a setup's overrides and one ladder value applied.
 struct SweepPoint {
   size_t scene_index = 0, setup_index = 0, ladder_index = 0;
+  size_t grid_index = 0;  // 0 without a grid
   std::string id;  // sweep_point_id(...)
   Scene scene;     // as run (every override applied)
 };
@@ -57,7 +78,7 @@ struct SweepPlan {
   SweepSpec spec;
   std::vector<Scene> scenes;                // the reference's scenes (duration override applied)
   std::vector<std::string> physics_hashes;  // physics_hash of each of those
-  std::vector<SweepPoint> points;           // scene-major, then setup, then ladder order
+  std::vector<SweepPoint> points;           // scene-major, then setup, then grid, then ladder order
   std::string plan_hash;                    // hash over the point ids: changes when any scene's physics does
 };
 
@@ -70,19 +91,24 @@ struct SweepPlan {
 //    each must load as a scene (its own error is quoted); no scene listed twice.
 //  - setup[i]: name (letters, digits, '.', '_', '-'; unique), engine (one of
 //    available_engines()), set (array of "KEY=VALUE" strings, optional), ladder = {key, values}
-//    (values a non-empty array of distinct finite numbers). A setup may only touch its engine's
-//    settings (engines.ENGINE.*) or, for the analytic model, run.rtol, run.atol and run.method:
-//    a sweep never changes the physics. The ladder key may not also be in `set`.
-//  - every scene with every setup and ladder value must load (the scene's checks and
-//    validate_engine_settings); the scene's message is quoted after the sweep key.
+//    (values a non-empty array of distinct values: all finite numbers, all strings that pass
+//    is_valid_name, or all booleans), grid = {key, values} (optional, the same rules; its key
+//    other than the ladder's). A setup may only touch its engine's settings (engines.ENGINE.*)
+//    or, for the analytic model, run.rtol, run.atol and run.method: a sweep never changes the
+//    physics. Neither axis' key may also be in `set`.
+//  - every scene with every setup, ladder and grid value must load (the scene's checks and
+//    validate_engine_settings: a value the engine setting refuses, "pyramid" for a cone, is
+//    refused here); the scene's message is quoted after the sweep key
+//    (setup[i].ladder.values[j] or setup[i].grid.values[j]).
 SweepPlan load_sweep(const std::string& path);
 
 // FNV-1a 64 of the parts, each followed by a 0 byte, as 16 hex digits.
 std::string fnv1a_hex(const std::vector<std::string>& parts);
 // Stable id of a point: hash of the scene's physics, the setup (name, engine, overrides, key),
-// the ladder value's text and the repeats.
+// the ladder value's text and the repeats; with a grid, then its key and the grid value's text
+// (a one-axis point's id is what it was before grids existed: published directories resume).
 std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& setup, const std::string& value_text,
-                           int repeats);
+                           int repeats, const std::string& grid_value_text = "");
 
 // ---- records ----------------------------------------------------------------------------------
 
@@ -114,8 +140,14 @@ struct SweepRecord {
   std::string setup, engine;
   std::vector<std::string> set;
   std::string ladder_key;
-  double ladder_value = 0;
+  double ladder_value = 0;   // NaN (null) for a value that is not a number
+  std::string ladder_label;  // the value as text ("0.001", "com", "true"); from the number in older records
   long long setup_index = 0, ladder_index = 0;
+  // The grid's axis ("grid": null without one, and in records from before grids).
+  std::string grid_key;  // empty: no grid
+  double grid_value = std::numeric_limits<double>::quiet_NaN();
+  std::string grid_label;
+  long long grid_index = 0;
   long long repeats = 1;
   double duration = 0;  // the scene's run.duration as run
   std::string status = "ok";
@@ -148,7 +180,8 @@ struct SweepRecord {
 };
 nlohmann::json to_json(const SweepRecord& r);
 // Every field checked for its type and range (indices 0 <= i < kMaxSweepPoints, repeats as in a
-// sweep file, counts >= 0, times and costs numbers or null, the class a known name);
+// sweep file, counts >= 0, times and costs numbers or null, the class a known name, keys and
+// labels of the axes names (is_valid_name) or numbers, a label equal to its axis' number);
 // throws SweepRecordError "KEY: reason" for anything else, another format included.
 SweepRecord sweep_record_from_json(const nlohmann::json& j);
 // One line of records.jsonl, '\n' included.
@@ -274,6 +307,35 @@ bool larger_is_softer(const std::string& ladder_key);
 // the first point out of the reference's regime; -1 when even the finest disagrees or there are
 // no points. Indices into `records`.
 long long softest_agreeing(const std::vector<SweepRecord>& records);
+
+// The text of an axis value of a record: the number as %g, else the label.
+std::string ladder_text(const SweepRecord& r);
+std::string grid_text(const SweepRecord& r);
+
+// "Modelling choices": what a choice axis (a setup's grid, or a ladder of non-numbers) does to the
+// verdict on one scene. At each value of the other axis (the step; a one-axis setup has one), the
+// choice's values are compared: the regime (inverts, does not invert, ends early) and, where
+// two or more invert, the relative spread of their inversion times, (max - min) / min.
+constexpr double kChoiceTimeThreshold = 0.01;  // a spread above this moves the verdict
+struct ChoiceEffect {
+  std::string scene, setup, engine;
+  std::string key, at_key;          // the choice axis; the other one ("" without)
+  std::vector<std::string> values;  // the choice's values, in sweep order
+  std::optional<double> reference_inversion;  // the reference's, on this scene
+  size_t steps = 0;                 // steps at which two or more values ran
+  bool regime_moves = false;
+  size_t regime_steps = 0;                    // steps at which the regime differs
+  std::string regime_at;                      // the first of them
+  std::vector<std::string> regime_outcomes;   // there, "VALUE: OUTCOME" for each value ("in the
+                                              // reference's regime" added where it is)
+  std::optional<double> largest_spread;       // over the steps where two or more invert
+  std::string spread_at;                      // the step of the largest spread
+  std::vector<std::string> spread_times;      // there, "VALUE T" for each value that inverts
+  bool time_moves() const { return largest_spread && *largest_spread > kChoiceTimeThreshold; }
+  bool moves() const { return regime_moves || time_moves(); }
+};
+// One entry per (scene, setup) with a choice axis, in sweep order.
+std::vector<ChoiceEffect> modelling_choices(const std::vector<SweepRecord>& records);
 
 // report.md, index.html and (when `plots`) the SVGs, into dir, from the records alone.
 void write_sweep_report(const std::string& dir, const std::vector<SweepRecord>& records, bool plots);

@@ -33,12 +33,6 @@ struct ShardDir {
 
 [[noreturn]] void refuse(const std::string& why) { throw SweepInputError(why); }
 
-std::string number_text(double v) {
-  std::ostringstream ss;
-  ss << v;
-  return ss.str();
-}
-
 ShardDir read_shard(const fs::path& dir) {
   ShardDir s;
   s.dir = dir;
@@ -130,7 +124,9 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
     for (const SweepRecord& r : s.records) {
       if (!own.count(r.point_id))
         refuse((s.dir / "records.jsonl").string() + ": point " + r.point_id + " (" + r.scene + ", " + r.setup + ", " +
-               r.ladder_key + " = " + number_text(r.ladder_value) + ") is not of shard " + shard_name(s));
+               r.ladder_key + " = " + ladder_text(r) +
+               (r.grid_key.empty() ? std::string() : ", " + r.grid_key + " = " + grid_text(r)) + ") is not of shard " +
+               shard_name(s));
       if (!seen.insert(r.point_id).second) continue;  // a duplicate line: the first counts, as in the report
       merged.push_back(&r);
       commits.insert(r.git_commit);
@@ -150,8 +146,8 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
     outcome.warnings.push_back("the shards' records come from more than one build (" + list + ")");
   }
   std::stable_sort(merged.begin(), merged.end(), [](const SweepRecord* a, const SweepRecord* b) {
-    return std::tie(a->scene_index, a->setup_index, a->ladder_index) <
-           std::tie(b->scene_index, b->setup_index, b->ladder_index);
+    return std::tie(a->scene_index, a->setup_index, a->grid_index, a->ladder_index) <
+           std::tie(b->scene_index, b->setup_index, b->grid_index, b->ladder_index);
   });
 
   // The output directory: new, or an earlier merge of the same sweep, or begun again (--restart).

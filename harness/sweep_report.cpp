@@ -141,6 +141,9 @@ bool larger_is_softer(const std::string& ladder_key) {
 
 long long softest_agreeing(const std::vector<SweepRecord>& records) {
   if (records.empty()) return -1;
+  // A ladder of choices has no softer end.
+  for (const SweepRecord& r : records)
+    if (!std::isfinite(r.ladder_value)) return -1;
   std::vector<size_t> order(records.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   const bool larger_soft = larger_is_softer(records.front().ladder_key);
@@ -170,9 +173,13 @@ std::string g3(double v) { return std::isfinite(v) ? fmt("%.3g", v) : "-"; }
 std::string pct(double v) { return std::isfinite(v) ? fmt("%.3g", 100 * v) + " %" : "-"; }
 std::string pct(const std::optional<double>& v) { return v ? pct(*v) : "-"; }
 std::string time_text(const std::optional<double>& t) { return t ? fmt("%.6g", *t) : "none"; }
-std::string setting_text(const SweepRecord& r) { return r.ladder_key + " = " + fmt("%g", r.ladder_value); }
+std::string last_part(const std::string& key) { return key.substr(key.rfind('.') + 1); }
+std::string setting_text(const SweepRecord& r) {
+  return r.ladder_key + " = " + ladder_text(r) + (r.grid_key.empty() ? "" : ", " + r.grid_key + " = " + grid_text(r));
+}
 std::string short_setting(const SweepRecord& r) {
-  return r.ladder_key.substr(r.ladder_key.rfind('.') + 1) + " = " + fmt("%g", r.ladder_value);
+  return last_part(r.ladder_key) + " = " + ladder_text(r) +
+         (r.grid_key.empty() ? "" : ", " + last_part(r.grid_key) + " = " + grid_text(r));
 }
 
 // A report as a list of blocks, rendered both as Markdown and as HTML.
@@ -296,8 +303,24 @@ std::string render_page(const std::vector<Block>& doc, const std::string& title)
 struct SetupGroup {
   std::string name, engine, key;
   std::vector<std::string> set;
+  std::vector<SweepRecord> points;  // grid, then ladder order
+  std::string grid_key;             // empty: no grid
+};
+
+// One line along a setup's ladder: the whole setup, or one grid value of it.
+struct Line {
+  std::string title;  // "SETUP", or "SETUP KEY=VALUE" (KEY the grid key's last part)
   std::vector<SweepRecord> points;  // ladder order
 };
+std::vector<Line> lines_of(const SetupGroup& u) {
+  std::vector<Line> out;
+  for (const SweepRecord& r : u.points) {
+    const std::string title = u.grid_key.empty() ? u.name : u.name + " " + last_part(u.grid_key) + "=" + grid_text(r);
+    if (out.empty() || out.back().title != title) out.push_back({title, {}});
+    out.back().points.push_back(r);
+  }
+  return out;
+}
 struct SceneGroup {
   std::string name, file;
   double duration = 0;
@@ -311,8 +334,8 @@ std::vector<SceneGroup> group(const std::vector<SweepRecord>& input) {
   for (const SweepRecord& r : input)
     if (seen.insert(r.point_id).second) records.push_back(r);
   std::stable_sort(records.begin(), records.end(), [](const SweepRecord& a, const SweepRecord& b) {
-    return std::tie(a.scene_index, a.setup_index, a.ladder_index) <
-           std::tie(b.scene_index, b.setup_index, b.ladder_index);
+    return std::tie(a.scene_index, a.setup_index, a.grid_index, a.ladder_index) <
+           std::tie(b.scene_index, b.setup_index, b.grid_index, b.ladder_index);
   });
   std::vector<SceneGroup> scenes;
   for (const SweepRecord& r : records) {
@@ -324,7 +347,7 @@ std::vector<SceneGroup> group(const std::vector<SweepRecord>& input) {
     }
     auto u = std::find_if(s->setups.begin(), s->setups.end(), [&](const SetupGroup& g) { return g.name == r.setup; });
     if (u == s->setups.end()) {
-      s->setups.push_back({r.setup, r.engine, r.ladder_key, r.set, {}});
+      s->setups.push_back({r.setup, r.engine, r.ladder_key, r.set, {}, r.grid_key});
       u = s->setups.end() - 1;
     }
     u->points.push_back(r);
@@ -373,10 +396,16 @@ struct Chart {
   std::vector<Series> series;
 };
 
-std::vector<Series> setup_series(const SceneGroup& s) {
+// One series per line (a setup, or a grid value of it), with the lines' points beside it.
+std::vector<Series> setup_series(const SceneGroup& s, std::vector<std::vector<SweepRecord>>& points) {
   std::vector<Series> out;
   std::map<std::string, int> per_engine;
-  for (const SetupGroup& u : s.setups) out.push_back({u.name, u.engine, per_engine[u.engine]++, {}});
+  points.clear();
+  for (const SetupGroup& u : s.setups)
+    for (Line& l : lines_of(u)) {
+      out.push_back({l.title, u.engine, per_engine[u.engine]++, {}});
+      points.push_back(std::move(l.points));
+    }
   return out;
 }
 
@@ -387,10 +416,11 @@ std::vector<Chart> make_charts(const SceneGroup& s) {
     c.file = "wp-" + s.name + "-" + m.key + ".svg";
     c.ylabel = m.label;
     c.title = s.name + ": " + m.key;
-    c.caption = s.name + ": " + m.label + " against CPU seconds, one line per setup along its ladder.";
-    c.series = setup_series(s);
-    for (size_t i = 0; i < s.setups.size(); ++i)
-      for (const SweepRecord& r : s.setups[i].points) {
+    c.caption = s.name + ": " + m.label + " against CPU seconds, one line per setup (per grid value) along its ladder.";
+    std::vector<std::vector<SweepRecord>> points;
+    c.series = setup_series(s, points);
+    for (size_t i = 0; i < points.size(); ++i)
+      for (const SweepRecord& r : points[i]) {
         const auto e = m.get(r);
         if (r.status == "ok" && e && usable(std::abs(*e)) && usable(r.cpu_seconds))
           c.series[i].xy.emplace_back(r.cpu_seconds, std::abs(*e));
@@ -408,10 +438,11 @@ std::vector<Chart> make_charts(const SceneGroup& s) {
                 "(at their status time).";
     c.logy = false;
     c.hline = s.duration;
-    c.series = setup_series(s);
+    std::vector<std::vector<SweepRecord>> points;
+    c.series = setup_series(s, points);
     Series early{"ended early", "", 0, {}};
-    for (size_t i = 0; i < s.setups.size(); ++i)
-      for (const SweepRecord& r : s.setups[i].points) {
+    for (size_t i = 0; i < points.size(); ++i)
+      for (const SweepRecord& r : points[i]) {
         if (!usable(r.cpu_seconds)) continue;
         if (r.inversion_time)
           c.series[i].xy.emplace_back(r.cpu_seconds, *r.inversion_time);
@@ -571,29 +602,30 @@ void scene_section(const SceneGroup& s, const std::vector<std::string>& images, 
   Table conv{{"setup", "engine", "ladder", "order (inversion time)", "points in the asymptotic range",
               "order (tilt RMS)", "points in the asymptotic range"},
              {}};
-  for (const SetupGroup& u : s.setups) {
-    const std::string last = u.key.substr(u.key.rfind('.') + 1);
-    if (last != "timestep") continue;
-    std::vector<double> h, e_inv, e_tilt;
-    for (const SweepRecord& r : u.points) {
-      const bool ok = r.status == "ok";
-      h.push_back(r.ladder_value);
-      e_inv.push_back(ok && r.metrics.inversion_time_rel_error ? std::abs(*r.metrics.inversion_time_rel_error)
-                                                               : std::nan(""));
-      e_tilt.push_back(ok ? r.metrics.tilt_rms_error : std::nan(""));
-    }
-    std::vector<std::string> row = {u.name, u.engine, u.key};
-    for (const auto* e : {&e_inv, &e_tilt}) {
-      if (e == &e_inv && !s.reference_inversion) {
-        row.insert(row.end(), {"-", "the reference does not invert"});
-        continue;
+  for (const SetupGroup& u : s.setups)
+    for (const Line& l : lines_of(u)) {
+      const std::string last = u.key.substr(u.key.rfind('.') + 1);
+      if (last != "timestep") continue;
+      std::vector<double> h, e_inv, e_tilt;
+      for (const SweepRecord& r : l.points) {
+        const bool ok = r.status == "ok";
+        h.push_back(r.ladder_value);
+        e_inv.push_back(ok && r.metrics.inversion_time_rel_error ? std::abs(*r.metrics.inversion_time_rel_error)
+                                                                 : std::nan(""));
+        e_tilt.push_back(ok ? r.metrics.tilt_rms_error : std::nan(""));
       }
-      const ConvergenceFit f = convergence_order(h, *e);
-      row.push_back(f.ok ? fmt("%.2f", f.order) : "-");
-      row.push_back(f.ok ? "dt = " + points_text(h, f.used) + (f.note.empty() ? "" : " (" + f.note + ")") : f.note);
+      std::vector<std::string> row = {l.title, u.engine, u.key};
+      for (const auto* e : {&e_inv, &e_tilt}) {
+        if (e == &e_inv && !s.reference_inversion) {
+          row.insert(row.end(), {"-", "the reference does not invert"});
+          continue;
+        }
+        const ConvergenceFit f = convergence_order(h, *e);
+        row.push_back(f.ok ? fmt("%.2f", f.order) : "-");
+        row.push_back(f.ok ? "dt = " + points_text(h, f.used) + (f.note.empty() ? "" : " (" + f.note + ")") : f.note);
+      }
+      conv.rows.push_back(row);
     }
-    conv.rows.push_back(row);
-  }
   if (!conv.rows.empty()) {
     doc.push_back({Block::H3, "Empirical order of convergence in the time step", {}, {}});
     doc.push_back({Block::Para,
@@ -617,20 +649,25 @@ void scene_section(const SceneGroup& s, const std::vector<std::string>& images, 
                  {},
                  {}});
   Table reg{{"setup", "engine", "softest setting in the reference's regime", "points out of the regime"}, {}};
-  for (const SetupGroup& u : s.setups) {
-    const long long k = softest_agreeing(u.points);
-    std::string out;
-    for (const SweepRecord& r : u.points)
-      if (!agrees_with_reference_regime(r)) {
-        std::string what = r.inversion_time
-                               ? "inverts at " + fmt("%.4g", *r.inversion_time)
-                               : (r.status == "ok" ? "no inversion" : r.status + " at " + fmt("%.4g", r.status_time));
-        out += (out.empty() ? "" : "; ") + fmt("%g", r.ladder_value) + ": " + what;
-      }
-    reg.rows.push_back({u.name, u.engine,
-                        k >= 0 ? setting_text(u.points[static_cast<size_t>(k)]) : "none (even the finest disagrees)",
-                        out.empty() ? "none" : out});
-  }
+  for (const SetupGroup& u : s.setups)
+    for (const Line& l : lines_of(u)) {
+      const long long k = softest_agreeing(l.points);
+      const bool choices = std::any_of(l.points.begin(), l.points.end(),
+                                       [](const SweepRecord& r) { return !std::isfinite(r.ladder_value); });
+      std::string out;
+      for (const SweepRecord& r : l.points)
+        if (!agrees_with_reference_regime(r)) {
+          std::string what = r.inversion_time
+                                 ? "inverts at " + fmt("%.4g", *r.inversion_time)
+                                 : (r.status == "ok" ? "no inversion" : r.status + " at " + fmt("%.4g", r.status_time));
+          out += (out.empty() ? "" : "; ") + ladder_text(r) + ": " + what;
+        }
+      reg.rows.push_back({l.title, u.engine,
+                          choices ? "- (a ladder of choices)"
+                          : k >= 0 ? setting_text(l.points[static_cast<size_t>(k)])
+                                   : "none (even the finest disagrees)",
+                          out.empty() ? "none" : out});
+    }
   doc.push_back({Block::Tab, "", reg, {}});
 
   if (!images.empty()) {
@@ -689,34 +726,42 @@ void stability_section(const std::vector<SceneGroup>& scenes, std::vector<Block>
     for (const SetupGroup& u : s.setups)
       if (std::find(order.begin(), order.end(), u.name) == order.end()) order.push_back(u.name);
   for (const std::string& name : order) {
-    std::map<long long, double> ladder;  // ladder index -> value
-    std::string key, engine;
+    std::map<long long, std::string> ladder, grid;  // index -> value as text
+    std::string key, grid_key, engine;
     for (const SceneGroup& s : scenes)
       for (const SetupGroup& u : s.setups)
         if (u.name == name) {
           key = u.key;
+          grid_key = u.grid_key;
           engine = u.engine;
-          for (const SweepRecord& r : u.points) ladder[r.ladder_index] = r.ladder_value;
+          for (const SweepRecord& r : u.points) {
+            ladder[r.ladder_index] = ladder_text(r);
+            if (!r.grid_key.empty()) grid[r.grid_index] = grid_text(r);
+          }
         }
+    // A grid: one row per scene and grid value.
+    if (grid.empty()) grid[0] = "";
     Table t{{"scene \\ " + key}, {}, {}};
-    for (const auto& [i, v] : ladder) t.header.push_back(fmt("%g", v));
-    for (const SceneGroup& s : scenes) {
-      std::vector<std::string> row{s.name}, css{""};
-      for (const auto& [i, v] : ladder) {
-        std::string cell = "-", c;
-        for (const SetupGroup& u : s.setups)
-          if (u.name == name)
-            for (const SweepRecord& r : u.points)
-              if (r.ladder_index == i) {
-                cell = class_cell(r);
-                c = class_css(r);
-              }
-        row.push_back(cell);
-        css.push_back(c);
+    for (const auto& [i, v] : ladder) t.header.push_back(v);
+    for (const SceneGroup& s : scenes)
+      for (const auto& [g, gv] : grid) {
+        std::vector<std::string> row{grid_key.empty() ? s.name : s.name + ", " + last_part(grid_key) + "=" + gv},
+            css{""};
+        for (const auto& [i, v] : ladder) {
+          std::string cell = "-", c;
+          for (const SetupGroup& u : s.setups)
+            if (u.name == name)
+              for (const SweepRecord& r : u.points)
+                if (r.ladder_index == i && r.grid_index == g) {
+                  cell = class_cell(r);
+                  c = class_css(r);
+                }
+          row.push_back(cell);
+          css.push_back(c);
+        }
+        t.rows.push_back(row);
+        t.css.push_back(css);
       }
-      t.rows.push_back(row);
-      t.css.push_back(css);
-    }
     doc.push_back({Block::H3, name + " (" + engine + ")", {}, {}});
     doc.push_back({Block::Tab, "", t, {}});
   }
@@ -751,6 +796,104 @@ void stability_section(const std::vector<SceneGroup>& scenes, std::vector<Block>
     rt.css.push_back({"", "", "", "", f->run_class == "ok" ? "c-ok" : "c-" + f->run_class});
   }
   doc.push_back({Block::Tab, "", rt, {}});
+}
+
+// A spread as a percentage; one below 1e-5 % of a time is rounding, said as such.
+std::string spread_text(double v) {
+  if (v == 0) return "0 %";
+  if (v < 1e-7) return "< 1e-5 %";
+  return pct(v);
+}
+
+std::string choice_verdict(const ChoiceEffect& e) {
+  if (e.regime_moves) return "moves the regime";
+  if (e.time_moves()) return "moves the inversion time by " + spread_text(*e.largest_spread);
+  if (e.steps == 0) return "not compared (no step at which two of its values ran)";
+  return "does not move the verdict";
+}
+
+std::string join_list(const std::vector<std::string>& v, const char* sep) {
+  std::string t;
+  for (const auto& x : v) t += (t.empty() ? "" : sep) + x;
+  return t;
+}
+
+// "at STEP" of the first step at which the regime differs, and at how many it does.
+std::string regime_where(const ChoiceEffect& e) {
+  if (e.regime_at.empty()) return "";
+  if (e.steps > 1 && e.regime_steps == e.steps) return "at every step (" + std::to_string(e.steps) + ")";
+  return "at " + e.regime_at +
+         (e.steps > 1 ? " (" + std::to_string(e.regime_steps) + " of " + std::to_string(e.steps) + " steps)" : "");
+}
+
+std::string choice_detail(const ChoiceEffect& e) {
+  const std::string at_regime = e.regime_at.empty() ? "" : regime_where(e) + ": ";
+  const std::string at_spread = e.spread_at.empty() ? "" : " at " + e.spread_at;
+  std::string spread = e.largest_spread ? "inversion times " + spread_text(*e.largest_spread) + " apart" + at_spread + " (" +
+                                              join_list(e.spread_times, ", ") + ")"
+                                        : std::string();
+  if (e.regime_moves) return at_regime + join_list(e.regime_outcomes, "; ") + (spread.empty() ? "" : "; " + spread);
+  if (!spread.empty()) return (e.time_moves() ? "largest: " : "the same regime at every step; largest: ") + spread;
+  if (e.steps == 0) return "-";
+  return "the same regime at every step; no step at which two of its values invert";
+}
+
+// Which choices (grid values, or a ladder of non-numbers) move the verdict on each scene.
+void choices_section(const std::vector<SweepRecord>& records, std::vector<Block>& doc) {
+  const std::vector<ChoiceEffect> effects = modelling_choices(records);
+  if (effects.empty()) return;
+  doc.push_back({Block::H2, "Modelling choices", {}, {}});
+  doc.push_back({Block::Para,
+                 "For each setup with a choice axis (its grid, or a ladder of non-numbers) on each scene: its values "
+                 "compared at the same value of the other axis (the time step). A choice moves the verdict when, at "
+                 "some step, its values give different regimes (one inverts, another does not, or a run ends early) "
+                 "or inversion times more than " +
+                     pct(kChoiceTimeThreshold) +
+                     " apart; the spread is (largest - smallest) / smallest of the inversion times at that step, the "
+                     "largest over the steps.",
+                 {},
+                 {}});
+  // Per engine: every choice key, and what it does on each scene.
+  std::vector<std::string> engines;
+  for (const ChoiceEffect& e : effects)
+    if (std::find(engines.begin(), engines.end(), e.engine) == engines.end()) engines.push_back(e.engine);
+  for (const std::string& engine : engines) {
+    std::vector<std::string> keys;
+    for (const ChoiceEffect& e : effects)
+      if (e.engine == engine && std::find(keys.begin(), keys.end(), e.key) == keys.end()) keys.push_back(e.key);
+    std::vector<std::string> parts;
+    for (const std::string& key : keys) {
+      std::vector<std::string> moves, stays;
+      for (const ChoiceEffect& e : effects) {
+        if (e.engine != engine || e.key != key) continue;
+        const std::string where = e.scene + (e.setup.empty() ? "" : " (" + e.setup + ")");
+        if (e.regime_moves)
+          moves.push_back(where + ": the regime" + (e.regime_at.empty() ? "" : " " + regime_where(e)) +
+                          (e.time_moves() ? ", and the inversion time by " + spread_text(*e.largest_spread) : ""));
+        else if (e.time_moves())
+          moves.push_back(where + ": the inversion time by " + spread_text(*e.largest_spread) +
+                          (e.spread_at.empty() ? "" : " at " + e.spread_at));
+        else
+          stays.push_back(where + (e.largest_spread ? ": within " + spread_text(*e.largest_spread)
+                                   : e.steps ? ": the same regime, never two inversions to compare"
+                                             : ": not compared"));
+      }
+      std::string t = last_part(key) + " ";
+      if (moves.empty())
+        t += "does not move the verdict (" + join_list(stays, "; ") + ")";
+      else
+        t += "moves it (" + join_list(moves, "; ") + ")" +
+             (stays.empty() ? "" : "; not on " + join_list(stays, "; "));
+      parts.push_back(t);
+    }
+    doc.push_back({Block::Para, engine + ": " + join_list(parts, ". ") + ".", {}, {}});
+  }
+  Table t{{"engine", "scene", "reference", "setup", "choice", "values", "verdict", "detail"}, {}};
+  for (const ChoiceEffect& e : effects)
+    t.rows.push_back({e.engine, e.scene,
+                      e.reference_inversion ? "inverts at " + fmt("%.5g", *e.reference_inversion) : "does not invert",
+                      e.setup, e.key, join_list(e.values, ", "), choice_verdict(e), choice_detail(e)});
+  doc.push_back({Block::Tab, "", t, {}});
 }
 
 std::vector<Block> build_doc(const std::vector<SweepRecord>& records, const std::vector<std::string>& images,
@@ -790,30 +933,125 @@ std::vector<Block> build_doc(const std::vector<SweepRecord>& records, const std:
     return doc;
   }
   Table st{{"setup", "engine", "fixed settings", "ladder"}, {}};
+  bool any_grid = false;
+  for (const SceneGroup& s : scenes)
+    for (const SetupGroup& u : s.setups) any_grid = any_grid || !u.grid_key.empty();
+  if (any_grid) st.header.push_back("grid");
   std::set<std::string> listed;
   for (const SceneGroup& s : scenes)
     for (const SetupGroup& u : s.setups) {
       if (!listed.insert(u.name).second) continue;
-      std::string set, ladder;
+      std::string set;
+      std::vector<std::string> ladder, grid;
       for (const auto& x : u.set) set += (set.empty() ? "" : "; ") + x;
-      for (const SweepRecord& r : u.points) ladder += (ladder.empty() ? "" : ", ") + fmt("%g", r.ladder_value);
-      st.rows.push_back({u.name, u.engine, set.empty() ? "-" : set, u.key + " = " + ladder});
+      for (const SweepRecord& r : u.points) {
+        if (std::find(ladder.begin(), ladder.end(), ladder_text(r)) == ladder.end()) ladder.push_back(ladder_text(r));
+        if (!u.grid_key.empty() && std::find(grid.begin(), grid.end(), grid_text(r)) == grid.end())
+          grid.push_back(grid_text(r));
+      }
+      const auto join = [](const std::vector<std::string>& v) {
+        std::string t;
+        for (const auto& x : v) t += (t.empty() ? "" : ", ") + x;
+        return t;
+      };
+      st.rows.push_back({u.name, u.engine, set.empty() ? "-" : set, u.key + " = " + join(ladder)});
+      if (any_grid) st.rows.back().push_back(u.grid_key.empty() ? "-" : u.grid_key + " = " + join(grid));
     }
   doc.push_back({Block::Tab, "", st, {}});
   if (!plots_note.empty()) doc.push_back({Block::Para, "Charts: " + plots_note + ".", {}, {}});
   doc.push_back({Block::Para,
-                 "Charts put error against cost on log-log axes, one line per setup (the analytic model's own "
+                 "Charts put error against cost on log-log axes, one line per setup (per grid value of a setup with a grid; the analytic model's own "
                  "tolerance ladders are the thick purple lines); runs that did not finish (diverged, failed, ...) and "
                  "errors of exactly 0 (a setting equal to the reference's) are left out of them and listed in the "
                  "tables.",
                  {},
                  {}});
+  choices_section(records, doc);
   stability_section(scenes, doc);
   for (const SceneGroup& s : scenes) scene_section(s, images, doc);
   return doc;
 }
 
 }  // namespace
+
+std::string ladder_text(const SweepRecord& r) {
+  return std::isfinite(r.ladder_value) ? fmt("%g", r.ladder_value) : r.ladder_label;
+}
+std::string grid_text(const SweepRecord& r) {
+  return std::isfinite(r.grid_value) ? fmt("%g", r.grid_value) : r.grid_label;
+}
+
+std::vector<ChoiceEffect> modelling_choices(const std::vector<SweepRecord>& records) {
+  std::vector<ChoiceEffect> out;
+  for (const SceneGroup& s : group(records))
+    for (const SetupGroup& u : s.setups) {
+      const bool grid = !u.grid_key.empty();
+      const bool categorical = std::any_of(u.points.begin(), u.points.end(),
+                                           [](const SweepRecord& r) { return !std::isfinite(r.ladder_value); });
+      if (!grid && !categorical) continue;
+      ChoiceEffect e;
+      e.scene = s.name;
+      e.setup = u.name;
+      e.engine = u.engine;
+      e.key = grid ? u.grid_key : u.key;
+      e.at_key = grid ? u.key : "";
+      e.reference_inversion = s.reference_inversion;
+      const auto choice = [&](const SweepRecord& r) { return grid ? grid_text(r) : ladder_text(r); };
+      std::map<long long, std::string> values;
+      std::map<long long, std::vector<const SweepRecord*>> steps;  // ladder index (grid) or one step
+      std::map<long long, std::string> step_text;
+      for (const SweepRecord& r : u.points) {
+        values.emplace(grid ? r.grid_index : r.ladder_index, choice(r));
+        const long long k = grid ? r.ladder_index : 0;
+        steps[k].push_back(&r);
+        step_text[k] = grid ? last_part(u.key) + " = " + ladder_text(r) : "";
+      }
+      for (const auto& [i, v] : values) e.values.push_back(v);
+      for (const auto& [k, pts] : steps) {
+        if (pts.size() < 2) continue;
+        ++e.steps;
+        // inverts / does not invert / ends early: a different one for any value moves the regime.
+        std::set<int> kinds;
+        std::vector<std::string> outcomes, times;
+        double lo = kInf, hi = -kInf;
+        for (const SweepRecord* r : pts) {
+          std::string what;
+          if (r->inversion_time) {
+            kinds.insert(0);
+            what = "inverts at " + fmt("%.5g", *r->inversion_time);
+            lo = std::min(lo, *r->inversion_time);
+            hi = std::max(hi, *r->inversion_time);
+            times.push_back(choice(*r) + " " + fmt("%.5g", *r->inversion_time));
+          } else if (r->status == "ok") {
+            kinds.insert(1);
+            what = "does not invert";
+          } else {
+            kinds.insert(2);
+            what = r->status + " at " + fmt("%.4g", r->status_time);
+          }
+          outcomes.push_back(choice(*r) + ": " + what + (agrees_with_reference_regime(*r) ? " (the reference's regime)" : ""));
+        }
+        if (kinds.size() > 1) {
+          if (!e.regime_moves) {
+            e.regime_at = step_text[k];
+            e.regime_outcomes = outcomes;
+          }
+          e.regime_moves = true;
+          ++e.regime_steps;
+        }
+        if (times.size() >= 2 && lo > 0) {
+          const double spread = (hi - lo) / lo;
+          if (!e.largest_spread || spread > *e.largest_spread) {
+            e.largest_spread = spread;
+            e.spread_at = step_text[k];
+            e.spread_times = times;
+          }
+        }
+      }
+      out.push_back(e);
+    }
+  return out;
+}
 
 std::string render_sweep_markdown(const std::vector<SweepRecord>& records) {
   return render_md(build_doc(records, {}, ""));

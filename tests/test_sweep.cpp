@@ -450,8 +450,8 @@ TEST(SweepFiles, InvalidFilesNameFileAndKey) {
                    "ladder.values = [1e-3, 0.5]\n",
        ": setup[0].ladder.values[1]: engines.ode.timestep: value 0.5 outside"},
       {kGoodHead + "[[setup]]\nname = \"x\"\nengine = \"ode\"\nladder.key = \"engines.ode.timestep\"\n"
-                   "ladder.values = [\"1e-3\"]\n",
-       ": setup[0].ladder.values[0]: expected a number, got a string"},
+                   "ladder.values = [\"fine\"]\n",
+       ": setup[0].ladder.values[0]: engines.ode.timestep: expected a number"},
       {kGoodHead + "[[setup]]\nname = \"x\"\nengine = \"ode\"\nset = [\"engines.ode.nosuch=1\"]\n"
                    "ladder.key = \"engines.ode.timestep\"\nladder.values = [1e-3]\n",
        ": setup[0].set[0]: engines.ode.nosuch: unknown setting"},
@@ -629,4 +629,329 @@ TEST(SweepCli, InvalidSweepExitsWithTwoAndWritesNothing) {
   e = run_tippe({"sweep", "--jobs", "0", kSmoke, "--out", out.string()}, err);
   EXPECT_EQ(e.code, 2);
   EXPECT_FALSE(fs::exists(out));
+}
+
+// ---- ladders: categorical values and grids ----------------------------------------------------
+
+// Published sweep directories resume only while a one-axis point keeps its id: the value below
+// was computed by the build before grids and categorical ladders existed.
+TEST(SweepLadders, OneAxisPointIdsAreThoseOfEarlierBuilds) {
+  SweepSetup u;
+  u.name = "ode";
+  u.engine = "ode";
+  u.set = {"engines.ode.iterations=50"};
+  u.ladder_key = "engines.ode.timestep";
+  EXPECT_EQ(sweep_point_id("fedcba9876543210", u, "0.001", 3), "c8db2ce8901bf92f");
+}
+
+
+namespace {
+
+const std::string kMujocoFrameGrid =
+    "[[setup]]\nname = \"mj\"\nengine = \"mujoco\"\n"
+    "ladder = { key = \"engines.mujoco.timestep\", values = [1e-3, 5e-4, 2.5e-4] }\n"
+    "grid = { key = \"engines.mujoco.body_frame\", values = [\"com\", \"ball_centre\"] }\n";
+
+// A grid point of the Modelling-choices fixtures: scene s, the setup's choice at `dt`.
+SweepRecord choice_point(const std::string& setup, long long grid_index, const std::string& choice, long long ladder_index,
+                         double dt, std::optional<double> inversion) {
+  SweepRecord r = point("mujoco", setup, dt, 1e-3 / dt, std::nullopt);
+  r.scene = "s";
+  r.point_id = setup + choice + std::to_string(ladder_index);
+  r.ladder_index = ladder_index;
+  r.grid_key = "engines.mujoco." + setup;
+  r.grid_label = choice;
+  r.grid_index = grid_index;
+  r.inversion_time = inversion;
+  if (inversion) {
+    r.metrics.inversion_event = "both";
+    r.metrics.inversion_time_rel_error = *inversion / 10.0 - 1;
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(SweepLadders, OneAxisPlanIdsAreTheOneAxisFormula) {
+  TempDir dir{"tippe-sweep"};
+  const SweepPlan plan = load_sweep(write_sweep(dir.path(), kGoodHead + kGoodSetup).string());
+  ASSERT_EQ(plan.points.size(), 2u);
+  const SweepSetup& u = plan.spec.setups[0];
+  EXPECT_FALSE(u.has_grid());
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(plan.points[k].grid_index, 0u);
+    EXPECT_EQ(plan.points[k].id, sweep_point_id(plan.physics_hashes[0], u, u.ladder_texts[k], 1));
+  }
+  EXPECT_EQ(u.ladder_labels, (std::vector<std::string>{"0.001", "0.0005"}));
+}
+
+TEST(SweepLadders, CategoricalLadderPlansOnePointPerValue) {
+  TempDir dir{"tippe-sweep"};
+  const fs::path p = write_sweep(dir.path(), kGoodHead +
+                                                 "[[setup]]\nname = \"mj\"\nengine = \"mujoco\"\n"
+                                                 "ladder.key = \"engines.mujoco.body_frame\"\n"
+                                                 "ladder.values = [\"com\", \"ball_centre\"]\n"
+                                                 "[[setup]]\nname = \"bt\"\nengine = \"bullet\"\n"
+                                                 "ladder.key = \"engines.bullet.velocity_friction_direction\"\n"
+                                                 "ladder.values = [true, false]\n");
+  const SweepPlan plan = load_sweep(p.string());
+  ASSERT_EQ(plan.points.size(), 4u);
+  const SweepSetup& u = plan.spec.setups[0];
+  EXPECT_EQ(u.ladder_texts, (std::vector<std::string>{"\"com\"", "\"ball_centre\""}));
+  EXPECT_EQ(u.ladder_labels, (std::vector<std::string>{"com", "ball_centre"}));
+  EXPECT_TRUE(std::isnan(u.ladder_values[0]) && std::isnan(u.ladder_values[1]));
+  EXPECT_EQ(std::get<std::string>(plan.points[1].scene.engines.at("mujoco").at("body_frame")), "ball_centre");
+  EXPECT_EQ(std::get<bool>(plan.points[3].scene.engines.at("bullet").at("velocity_friction_direction")), false);
+  EXPECT_EQ(plan.spec.setups[1].ladder_labels, (std::vector<std::string>{"true", "false"}));
+  std::set<std::string> ids;
+  for (const SweepPoint& q : plan.points) ids.insert(q.id);
+  EXPECT_EQ(ids.size(), 4u);
+  EXPECT_EQ(plan.points[0].id, sweep_point_id(plan.physics_hashes[0], u, "\"com\"", 1));
+  EXPECT_EQ(load_sweep(p.string()).plan_hash, plan.plan_hash) << "ids are stable";
+}
+
+TEST(SweepLadders, GridPlansEveryPairGridThenLadder) {
+  TempDir dir{"tippe-sweep"};
+  const fs::path p = write_sweep(dir.path(), kGoodHead + kMujocoFrameGrid + kGoodSetup);
+  const SweepPlan plan = load_sweep(p.string());
+  ASSERT_EQ(plan.points.size(), 6u + 2u);
+  const SweepSetup& u = plan.spec.setups[0];
+  ASSERT_TRUE(u.has_grid());
+  EXPECT_EQ(u.point_count(), 6u);
+  EXPECT_EQ(u.grid_labels, (std::vector<std::string>{"com", "ball_centre"}));
+  const std::vector<std::pair<size_t, size_t>> order = {{0, 0}, {0, 1}, {0, 2}, {1, 0}, {1, 1}, {1, 2}};
+  std::set<std::string> ids;
+  for (size_t i = 0; i < 6; ++i) {
+    const SweepPoint& q = plan.points[i];
+    EXPECT_EQ(q.grid_index, order[i].first) << i;
+    EXPECT_EQ(q.ladder_index, order[i].second) << i;
+    const auto& mj = q.scene.engines.at("mujoco");
+    EXPECT_EQ(std::get<std::string>(mj.at("body_frame")), u.grid_labels[q.grid_index]) << i;
+    EXPECT_EQ(std::get<double>(mj.at("timestep")), u.ladder_values[q.ladder_index]) << i;
+    EXPECT_EQ(q.id, sweep_point_id(plan.physics_hashes[0], u, u.ladder_texts[q.ladder_index], 1,
+                                   u.grid_texts[q.grid_index]));
+    ids.insert(q.id);
+  }
+  EXPECT_EQ(ids.size(), 6u);
+  // The grid's points are not the one-axis points of the same ladder, and the one-axis setup
+  // beside it keeps its ids.
+  EXPECT_FALSE(ids.count(sweep_point_id(plan.physics_hashes[0], u, u.ladder_texts[0], 1)));
+  const SweepPlan alone = load_sweep(write_sweep(dir.path(), kGoodHead + kGoodSetup, "alone.toml").string());
+  EXPECT_EQ(plan.points[6].id, alone.points[0].id);
+  EXPECT_EQ(plan.points[7].id, alone.points[1].id);
+  EXPECT_EQ(load_sweep(p.string()).plan_hash, plan.plan_hash);
+  // The shipped modelling sweep is a grid on every setup.
+  const SweepPlan modelling = load_sweep(kSource + "/harness/sweeps/modelling.toml");
+  for (const SweepSetup& s : modelling.spec.setups) EXPECT_TRUE(s.has_grid()) << s.name;
+  EXPECT_GE(modelling.points.size(), 2u * 6 * 2);
+}
+
+TEST(SweepLadders, GridRecordsRoundTripAndOldRecordsReadBack) {
+  SweepRecord r = sample_record();
+  r.ladder_key = "engines.mujoco.body_frame";
+  r.ladder_value = std::nan("");
+  r.ladder_label = "ball_centre";
+  r.grid_key = "engines.mujoco.noslip_iterations";
+  r.grid_value = 10;
+  r.grid_label = "10";
+  r.grid_index = 1;
+  const std::string line = to_jsonl(r);
+  const SweepRecord back = sweep_record_from_json(json::parse(line));
+  EXPECT_EQ(to_jsonl(back), line);
+  EXPECT_TRUE(std::isnan(back.ladder_value));
+  EXPECT_EQ(back.ladder_label, "ball_centre");
+  EXPECT_EQ(back.grid_key, r.grid_key);
+  EXPECT_EQ(back.grid_value, 10);
+  EXPECT_EQ(back.grid_label, "10");
+  EXPECT_EQ(back.grid_index, 1);
+  EXPECT_EQ(ladder_text(back), "ball_centre");
+  EXPECT_EQ(grid_text(back), "10");
+
+  // A record from before grids and categorical ladders: no ladder_label, no grid.
+  json old = to_json(sample_record());
+  old.erase("ladder_label");
+  old.erase("grid");
+  const SweepRecord o = sweep_record_from_json(old);
+  EXPECT_EQ(o.ladder_value, 3e-5);
+  EXPECT_EQ(o.ladder_label, "3e-05");
+  EXPECT_TRUE(o.grid_key.empty());
+  EXPECT_EQ(o.grid_index, 0);
+  EXPECT_EQ(json::parse(to_jsonl(sample_record()))["grid"], nullptr);
+}
+
+// Keys and labels read back become report labels and gnuplot column headers: names or numbers,
+// and a label says the number beside it.
+TEST(SweepLadders, GridFieldsReadBackAreCheckedByKey) {
+  auto message = [](const json& j) -> std::string {
+    try {
+      sweep_record_from_json(j);
+    } catch (const SweepRecordError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  SweepRecord g = sample_record();
+  g.grid_key = "engines.mujoco.cone";
+  g.grid_label = "pyramidal";
+  g.grid_index = 1;
+  const json good = to_json(g);
+  EXPECT_EQ(message(good), "accepted");
+  json j = good;
+  j["grid"]["label"] = "a'b\"; system";
+  EXPECT_EQ(message(j).rfind("grid.label: \"a'b\"; system\" is neither a number nor a usable name", 0), 0u) << message(j);
+  j = good;
+  j["grid"]["key"] = "engines mujoco";
+  EXPECT_EQ(message(j).rfind("grid.key: \"engines mujoco\" is not a usable key", 0), 0u) << message(j);
+  j = good;
+  j["grid"]["index"] = -1;
+  EXPECT_EQ(message(j).rfind("grid.index: -1 is out of range", 0), 0u) << message(j);
+  j = good;
+  j["grid"]["value"] = "x";
+  EXPECT_EQ(message(j), "grid.value: expected a number or null, got string");
+  j = good;
+  j["grid"]["label"] = "5";
+  EXPECT_EQ(message(j), "grid.label: \"5\" is a number, but grid.value is null");
+  j = good;
+  j["grid"] = 3;
+  EXPECT_EQ(message(j).rfind("grid: expected an object", 0), 0u) << message(j);
+  j = good;
+  j["ladder_label"] = "0.002";
+  EXPECT_EQ(message(j), "ladder_label: \"0.002\" is not ladder_value 3e-05");
+  j = good;
+  j["ladder_value"] = nullptr;
+  j.erase("ladder_label");
+  EXPECT_EQ(message(j), "ladder_label: missing (required when ladder_value is null)");
+  j = good;
+  j["ladder_key"] = "$(rm -rf x)";
+  EXPECT_EQ(message(j).rfind("ladder_key: \"$(rm -rf x)\" is not a usable key", 0), 0u) << message(j);
+
+  TempDir dir{"tippe-sweep"};
+  const fs::path file = dir.path() / "records.jsonl";
+  j = good;
+  j["grid"]["label"] = "a b";
+  spit(file, to_jsonl(g) + j.dump() + "\n");
+  try {
+    read_records(file.string());
+    FAIL() << "no exception";
+  } catch (const SweepRecordError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(file.string() + ":2: grid.label: \"a b\" is neither", 0), 0u) << e.what();
+  }
+}
+
+TEST(SweepLadders, ModellingChoicesFindWhatMovesTheVerdict) {
+  std::vector<SweepRecord> recs;
+  long long setup_index = 0;
+  const std::vector<double> steps = {1e-3, 5e-4};
+  // body_frame: at the coarse step ball_centre does not invert (the regime moves); cone:
+  // pyramidal inverts 5 % later; noslip_iterations: 0.5 % apart, within the 1 % threshold.
+  const struct {
+    std::string setup, a, b;
+    std::vector<std::optional<double>> ta, tb;
+  } fixtures[] = {
+      {"body_frame", "com", "ball_centre", {4.0, 4.0}, {std::nullopt, 4.01}},
+      {"cone", "elliptic", "pyramidal", {4.0, 4.0}, {4.1, 4.2}},
+      {"noslip_iterations", "0", "10", {4.0, 4.0}, {4.01, 4.02}},
+  };
+  for (const auto& f : fixtures) {
+    for (long long k = 0; k < 2; ++k) {
+      SweepRecord a = choice_point(f.setup, 0, f.a, k, steps[k], f.ta[k]);
+      SweepRecord b = choice_point(f.setup, 1, f.b, k, steps[k], f.tb[k]);
+      if (f.setup == "noslip_iterations") a.grid_value = 0, b.grid_value = 10;
+      a.setup_index = b.setup_index = setup_index;
+      recs.push_back(a);
+      recs.push_back(b);
+    }
+    ++setup_index;
+  }
+  const std::vector<ChoiceEffect> effects = modelling_choices(recs);
+  ASSERT_EQ(effects.size(), 3u);
+  const ChoiceEffect& frame = effects[0];
+  EXPECT_EQ(frame.key, "engines.mujoco.body_frame");
+  EXPECT_EQ(frame.values, (std::vector<std::string>{"com", "ball_centre"}));
+  EXPECT_EQ(frame.steps, 2u);
+  EXPECT_TRUE(frame.regime_moves);
+  EXPECT_EQ(frame.regime_at, "timestep = 0.001");
+  EXPECT_EQ(frame.regime_steps, 1u);
+  EXPECT_EQ(frame.regime_outcomes,
+            (std::vector<std::string>{"com: inverts at 4 (the reference's regime)", "ball_centre: does not invert"}));
+  EXPECT_TRUE(frame.moves());
+  const ChoiceEffect& cone = effects[1];
+  EXPECT_FALSE(cone.regime_moves);
+  ASSERT_TRUE(cone.largest_spread);
+  EXPECT_NEAR(*cone.largest_spread, 0.05, 1e-12);
+  EXPECT_EQ(cone.spread_at, "timestep = 0.0005");
+  EXPECT_TRUE(cone.time_moves());
+  const ChoiceEffect& noslip = effects[2];
+  EXPECT_FALSE(noslip.regime_moves);
+  ASSERT_TRUE(noslip.largest_spread);
+  EXPECT_NEAR(*noslip.largest_spread, 0.005, 1e-12);
+  EXPECT_FALSE(noslip.moves());
+
+  const std::string md = render_sweep_markdown(recs);
+  EXPECT_NE(md.find("## Modelling choices"), std::string::npos) << md;
+  EXPECT_NE(md.find("mujoco: body_frame moves it (s (body_frame): the regime at timestep = 0.001 (1 of 2 steps)). cone moves it (s "
+                    "(cone): the inversion time by 5 % at timestep = 0.0005). noslip_iterations does not move the "
+                    "verdict (s (noslip_iterations): within 0.5 %)."),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| mujoco | s | inverts at 10 | body_frame | engines.mujoco.body_frame | com, ball_centre | moves the regime | at "
+                    "timestep = 0.001 (1 of 2 steps): com: inverts at 4 (the reference's regime); ball_centre: does not invert;"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| moves the inversion time by 5 % | largest: inversion times 5 % apart at timestep = 0.0005 "
+                    "(elliptic 4, pyramidal 4.2) |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| noslip_iterations | engines.mujoco.noslip_iterations | 0, 10 | does not move the verdict |"),
+            std::string::npos)
+      << md;
+  // One line per grid value wherever the report walks a ladder.
+  EXPECT_NE(md.find("| cone cone=pyramidal | mujoco |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| s, cone=pyramidal |"), std::string::npos) << md;
+  // A sweep without choices has no such section.
+  std::vector<SweepRecord> plain = {point("ode", "ode", 1e-3, 1, 0.01)};
+  plain[0].scene = "s";
+  EXPECT_EQ(render_sweep_markdown(plain).find("Modelling choices"), std::string::npos);
+}
+
+TEST(SweepLadders, BadCategoricalValuesAreRefusedAtLoad) {
+  TempDir dir{"tippe-sweep"};
+  const std::string mj = "[[setup]]\nname = \"mj\"\nengine = \"mujoco\"\n";
+  const std::string steps = "ladder = { key = \"engines.mujoco.timestep\", values = [1e-3, 5e-4] }\n";
+  struct Case {
+    std::string body, expected;
+  };
+  const std::vector<Case> cases = {
+      {mj + steps + "grid = { key = \"engines.mujoco.cone\", values = [\"elliptic\", \"pyramid\"] }\n",
+       ": setup[0].grid.values[1]: engines.mujoco.cone: value \"pyramid\" is not one of: elliptic, pyramidal"},
+      {mj + "ladder = { key = \"engines.mujoco.body_frame\", values = [\"com\", \"middle\"] }\n",
+       ": setup[0].ladder.values[1]: engines.mujoco.body_frame: value \"middle\" is not one of: com, ball_centre"},
+      {mj + steps + "grid = { key = \"engines.mujoco.noslip_iterations\", values = [\"many\"] }\n",
+       ": setup[0].grid.values[0]: engines.mujoco.noslip_iterations: expected an integer"},
+      {mj + steps + "grid = { key = \"engines.mujoco.body_frame\", values = [\"com\", 1] }\n",
+       ": setup[0].grid.values[1]: expected a string like setup[0].grid.values[0], got an integer 1 (an axis' values are all "
+       "numbers, all strings or all booleans)"},
+      {mj + steps + "grid = { key = \"engines.mujoco.body_frame\", values = [\"com\", \"com\"] }\n",
+       ": setup[0].grid.values[1]: com repeats setup[0].grid.values[0]"},
+      {mj + steps + "grid = { key = \"engines.mujoco.body_frame\", values = [\"a b\"] }\n",
+       ": setup[0].grid.values[0]: \"a b\" is not a usable value"},
+      {mj + steps + "grid = { key = \"engines.mujoco.timestep\", values = [1e-4] }\n",
+       ": setup[0].grid.key: engines.mujoco.timestep is also setup[0]'s ladder key"},
+      {mj + "set = [\"engines.mujoco.cone=\\\"pyramidal\\\"\"]\n" + steps +
+           "grid = { key = \"engines.mujoco.cone\", values = [\"elliptic\"] }\n",
+       ": setup[0].grid.key: engines.mujoco.cone is also fixed in setup[0].set"},
+      {mj + steps + "grid = { key = \"contact.mu\", values = [0.1, 0.2] }\n",
+       ": setup[0].grid.key: \"contact.mu\" is not a setting of mujoco"},
+      {mj + steps + "grid = { key = \"engines.mujoco.cone\", values = [] }\n",
+       ": setup[0].grid.values: must list at least one value"},
+      {mj + steps + "grid = { key = \"engines.mujoco.cone\", values = [\"elliptic\"], by = 2 }\n",
+       ": setup[0].grid.by: unknown key (expected one of: key, values)"},
+      {mj + steps + "grid = { key = \"engines.mujoco.cone\", values = [{ a = 1 }] }\n",
+       ": setup[0].grid.values[0]: expected a number, a string or a boolean, got"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const fs::path p = write_sweep(dir.path(), kGoodHead + cases[i].body, "bad" + std::to_string(i) + ".toml");
+    const std::string msg = load_error(p);
+    EXPECT_EQ(msg.rfind(p.string() + cases[i].expected, 0), 0u) << "case " << i << ": " << msg;
+  }
 }

@@ -360,6 +360,56 @@ TEST(SweepShards, AFailingReferenceIsRecordedForItsSceneAndTheOtherScenesRun) {
 
 // ---- MPI --------------------------------------------------------------------------------------
 
+// A grid and a categorical ladder: every point is an ordinary point, so shards, merges, resumed
+// runs and MPI ranks give the records of one local run.
+std::string grid_sweep(const TempDir& dir) {
+  return dir.write("grid.toml", "description = \"a grid\"\nduration = 0.3\nscenes = [\"" + kSource +
+                                    "/harness/scenes/toy.toml\"]\n"
+                                    "[[setup]]\nname = \"ode\"\nengine = \"ode\"\n"
+                                    "ladder = { key = \"engines.ode.timestep\", values = [1e-3, 2e-3] }\n"
+                                    "grid = { key = \"engines.ode.friction_model\", values = [\"approx1\", \"box\"] }\n"
+                                    "[[setup]]\nname = \"mujoco\"\nengine = \"mujoco\"\n"
+                                    "ladder = { key = \"engines.mujoco.body_frame\", values = [\"com\", \"ball_centre\"] }\n");
+}
+
+TEST(SweepShards, GridAndCategoricalLaddersShardMergeAndResumeAsOneRun) {
+  TempDir dir("tippe-grid");
+  const std::string sweep = grid_sweep(dir);
+  const fs::path log = dir.path() / "log", local = dir.path() / "local";
+  ASSERT_EQ(run(tippe_sweep({sweep, "--out", local.string(), "--jobs", "2"}), log), 0) << slurp(log);
+  const std::vector<json> lines = lines_of(local / "records.jsonl");
+  ASSERT_EQ(lines.size(), 6u);
+  std::set<std::string> cells;
+  for (const json& r : lines)
+    if (r.at("setup") == "ode")
+      cells.insert(r.at("ladder_label").get<std::string>() + "/" + r.at("grid").at("label").get<std::string>());
+    else
+      cells.insert(r.at("ladder_label").get<std::string>() + (r.at("grid").is_null() ? "" : "?"));
+  EXPECT_EQ(cells, (std::set<std::string>{"0.001/approx1", "0.001/box", "0.002/approx1", "0.002/box", "com",
+                                          "ball_centre"}));
+  EXPECT_NE(slurp(local / "report.md").find("## Modelling choices"), std::string::npos);
+
+  std::vector<std::string> merge = {"--merge"};
+  for (int i = 0; i < 2; ++i) {
+    const std::string d = (dir.path() / ("shard" + std::to_string(i))).string();
+    ASSERT_EQ(run(tippe_sweep({sweep, "--shard", std::to_string(i) + "/2", "--out", d, "--jobs", "1"}), log), 0)
+        << slurp(log);
+    merge.push_back(d);
+  }
+  const fs::path merged = dir.path() / "merged";
+  merge.insert(merge.end(), {"--out", merged.string()});
+  ASSERT_EQ(run(tippe_sweep(merge), log), 0) << slurp(log);
+  expect_same_records(local, merged);
+  // The merge writes plan order: grid, then ladder, within a setup.
+  const std::vector<json> m = lines_of(merged / "records.jsonl");
+  ASSERT_EQ(m.size(), 6u);
+  EXPECT_EQ(m[1].at("grid").at("label"), "approx1");
+  EXPECT_EQ(m[1].at("ladder_label"), "0.002");
+  EXPECT_EQ(m[2].at("grid").at("label"), "box");
+  ASSERT_EQ(run(tippe_sweep({sweep, "--out", merged.string(), "--jobs", "1"}), log), 0) << slurp(log);
+  EXPECT_NE(slurp(log).find("(6 from an earlier run, 0 run now)"), std::string::npos) << slurp(log);
+}
+
 #ifdef TIPPE_HAVE_MPI
 
 // Where mpirun is; "" when not on PATH.
@@ -403,6 +453,16 @@ TEST(SweepMpi, TwoAndThreeRanksGiveTheRecordsOfOneJob) {
     const json a = json::parse(slurp(local_smoke() / "sweep.json")), b = json::parse(slurp(out / "sweep.json"));
     EXPECT_EQ(a["plan_hash"], b["plan_hash"]);
   }
+}
+
+TEST(SweepMpi, GridAndCategoricalLaddersRunUnderMpiAsOneLocalRun) {
+  REQUIRE_MPIRUN();
+  TempDir dir("tippe-grid-mpi");
+  const std::string sweep = grid_sweep(dir);
+  const fs::path log = dir.path() / "log", local = dir.path() / "local", np2 = dir.path() / "np2";
+  ASSERT_EQ(run(tippe_sweep({sweep, "--out", local.string(), "--jobs", "1"}), log), 0) << slurp(log);
+  ASSERT_EQ(run(mpirun_sweep(2, {sweep, "--out", np2.string()}), log), 0) << slurp(log);
+  expect_same_records(local, np2);
 }
 
 TEST(SweepMpi, ShardsRunUnderMpiToo) {
