@@ -64,6 +64,9 @@ struct RunSpec {
   // (Dormand-Prince 5(4)) or "rosenbrock4" (linearly implicit, order 4, for stiff runs such as
   // the viscous law at large k); all with dense output for event location.
   std::string method = "bulirsch_stoer";
+  // The harness runs a second, independent reference over the same scene and says from which
+  // time on the two part (the reference's self-check, harness/compare.h); false skips it.
+  bool self_check = true;
 };
 
 // One value of an engine setting as written in a scene or on the command line.

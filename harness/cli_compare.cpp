@@ -26,6 +26,7 @@ struct CompareCliOptions {
   std::string cache = "out/.reference-cache";
   bool no_cache = false;
   bool no_plots = false;
+  bool no_self_check = false;
 };
 
 void print_table_and_findings(const nlohmann::json& j) {
@@ -34,7 +35,8 @@ void print_table_and_findings(const nlohmann::json& j) {
 }
 
 int compare(const CompareCliOptions& o) {
-  const Scene scene = load_scene(o.scene, o.sets);
+  Scene scene = load_scene(o.scene, o.sets);
+  if (o.no_self_check) scene.run.self_check = false;
   CompareOptions opts;
   opts.engines = o.engines;
   const int runs = static_cast<int>(o.engines.size()) + 1;
@@ -104,6 +106,9 @@ Command setup_compare(CLI::App& app) {
   sub->add_option("--cache", o->cache, "Reference cache directory")->capture_default_str();
   sub->add_flag("--no-cache", o->no_cache, "Always run the reference; leave the cache alone");
   sub->add_flag("--no-plots", o->no_plots, "Skip the gnuplot SVGs");
+  sub->add_flag("--no-self-check", o->no_self_check,
+                "Skip the reference's self-check (a second reference run with another method; same as "
+                "--set run.self_check=false)");
   return {sub, [o] { return compare(*o); }};
 }
 

@@ -170,12 +170,26 @@ bool energy_must_not_rise(const Scene& scene) {
 }
 
 Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, const RunRecord& engine,
-                     const Trajectory& engine_traj, const Scene& scene) {
+                     const Trajectory& engine_traj, const Scene& scene, std::optional<double> converged_until) {
   Metrics m;
-  compare_event(reference.inversion_time, engine.inversion_time, m.inversion_event, m.inversion_time_abs_error,
-                m.inversion_time_rel_error);
-  compare_event(reference.stem_contact_time, engine.stem_contact_time, m.stem_contact_event,
-                m.stem_contact_time_abs_error, m.stem_contact_time_rel_error);
+  m.reference_converged_until = converged_until;
+  // Inside the window: the reference's event when it has one, else the engine's (a converged
+  // reference could have the event later); an event neither has is not known past the window.
+  auto judged = [&](const std::optional<double>& t_ref, const std::optional<double>& t_eng) {
+    if (!converged_until) return true;
+    if (t_ref) return *t_ref <= *converged_until;
+    return t_eng && *t_eng <= *converged_until;
+  };
+  if (judged(reference.inversion_time, engine.inversion_time))
+    compare_event(reference.inversion_time, engine.inversion_time, m.inversion_event, m.inversion_time_abs_error,
+                  m.inversion_time_rel_error);
+  else
+    m.inversion_event = "unconverged";
+  if (judged(reference.stem_contact_time, engine.stem_contact_time))
+    compare_event(reference.stem_contact_time, engine.stem_contact_time, m.stem_contact_event,
+                  m.stem_contact_time_abs_error, m.stem_contact_time_rel_error);
+  else
+    m.stem_contact_event = "unconverged";
 
   const double R = scene.body.sphere_radius;
   const double E0_ref = ref_traj.size() ? ref_traj.energy.front() : reference.energy_initial;
@@ -185,8 +199,11 @@ Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, con
   size_t offset = 0;
   const Trajectory eng = engine_on_reference_grid(ref_traj, engine_traj, scene.run.sample_interval, offset);
   ErrorStats tilt, energy, contact, com, latitude;
+  size_t compared = 0;
   for (size_t k = 0; k < eng.size(); ++k) {
     const size_t r = offset + k;
+    if (converged_until && ref_traj.t[r] > *converged_until) break;
+    compared = k + 1;
     tilt.add(eng.theta[k] - ref_traj.theta[r]);
     energy.add((eng.energy[k] - ref_traj.energy[r]) / e_scale);
     contact.add(std::hypot(eng.x_C[k] - ref_traj.x_C[r], eng.y_C[k] - ref_traj.y_C[r]) / R);
@@ -201,7 +218,7 @@ Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, con
   m.com_path_rms_error = com.rms();
   m.com_path_max_error = com.maximum();
   m.latitude_rms_error = latitude.rms();
-  m.compared_until = eng.size() ? eng.t.back() : kNaN;
+  m.compared_until = compared ? eng.t[compared - 1] : kNaN;
 
   if (engine_traj.size()) {
     const double E0 = engine_traj.energy.front();
@@ -262,6 +279,7 @@ json to_json(const Metrics& m) {
       {"steps", m.steps},
       {"cost_ratio", number(m.cost_ratio)},
       {"compared_until", number(m.compared_until)},
+      {"reference_converged_until", number(m.reference_converged_until)},
   };
 }
 
@@ -293,6 +311,16 @@ Metrics metrics_from_json(const json& j) {
   m.steps = json_integer(j, "steps");
   m.cost_ratio = get_number(j, "cost_ratio");
   m.compared_until = get_number(j, "compared_until");
+  // Absent in records written before the reference's self-check.
+  if (j.contains("reference_converged_until")) {
+    const json& v = j.at("reference_converged_until");
+    if (!v.is_null()) {
+      const double t = v.get<double>();
+      if (!(std::isfinite(t) && t >= 0))
+        throw std::invalid_argument("metrics.reference_converged_until: " + v.dump() + " is not a time >= 0 or null");
+      m.reference_converged_until = t;
+    }
+  }
   return m;
 }
 
@@ -301,6 +329,8 @@ Metrics metrics_from_json(const json& j) {
 std::string physics_hash(const json& scene_json) {
   json physics = scene_json;
   for (const char* key : {"engines", "name", "description", "source_file", "content_hash"}) physics.erase(key);
+  // Whether the reference is checked is not physics: the same reference serves both.
+  if (physics.contains("run") && physics["run"].is_object()) physics["run"].erase("self_check");
   // nlohmann::json keeps object keys sorted, so dump() is canonical.
   const std::string text = physics.dump();
   std::uint64_t h = 14695981039346656037ull;
@@ -314,6 +344,158 @@ std::string physics_hash(const json& scene_json) {
 }
 
 std::string physics_hash(const Scene& scene) { return physics_hash(scene_to_json(scene)); }
+
+// ---- the reference's self-check ----------------------------------------------------------------
+
+SelfCheckMethod self_check_method(const RunSpec& run) {
+  if (run.method == "rosenbrock4") {
+    // Stiff scenes: see compare.h. The bounds are the scene reader's (rtol >= 1e-15; atol > 0).
+    return {"rosenbrock4", std::max(run.rtol / 10, 1e-15), run.atol / 10};
+  }
+  return {run.method == "dopri5" ? "bulirsch_stoer" : "dopri5", run.rtol, run.atol};
+}
+
+double self_check_event_tolerance(const Scene& scene) {
+  return std::min(std::max(1e3 * scene.run.rtol, 1e-9), 1e-5) * scene.run.duration;
+}
+
+namespace {
+
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// The earliest of several places where the two runs part.
+struct Parting {
+  std::optional<double> t;
+  std::string reason;
+  void consider(double at, std::string why) {
+    if (!t || at < *t) {
+      t = at;
+      reason = std::move(why);
+    }
+  }
+};
+
+}  // namespace
+
+SelfCheck compare_reference_runs(const RunRecord& reference, const Trajectory& ref_traj, const RunRecord& check,
+                                 const Trajectory& check_traj, const Scene& scene) {
+  SelfCheck sc;
+  const SelfCheckMethod plan = self_check_method(scene.run);
+  sc.method = plan.method;
+  sc.rtol = plan.rtol;
+  sc.atol = plan.atol;
+  sc.cpu_seconds = check.work.cpu_seconds;
+  const std::string a = scene.run.method, b = plan.method == a ? a + " at rtol " + short_number(plan.rtol) : plan.method;
+  Parting part;
+
+  // Events, in order: the same names and details, at times within the tolerance.
+  const double tol = self_check_event_tolerance(scene);
+  const auto& ea = reference.events;
+  const auto& eb = check.events;
+  const size_t n = std::min(ea.size(), eb.size());
+  for (size_t i = 0; i < n; ++i) {
+    const Event& x = ea[i];
+    const Event& y = eb[i];
+    if (x.name != y.name || x.detail != y.detail) {
+      part.consider(std::min(x.time, y.time), "event " + std::to_string(i) + ": " + a + " has " + x.name + " (" +
+                                                 x.detail + ") at t = " + short_number(x.time) + ", " + b +
+                                                 " has " + y.name + " (" + y.detail + ") at t = " +
+                                                 short_number(y.time));
+      break;
+    }
+    if (!(std::abs(x.time - y.time) <= tol)) {
+      part.consider(std::min(x.time, y.time), "event " + std::to_string(i) + " (" + x.name + ") at t = " +
+                                                 short_number(x.time) + " and " + short_number(y.time) +
+                                                 ": the times differ by " + short_number(std::abs(x.time - y.time)) +
+                                                 " > " + short_number(tol));
+      break;
+    }
+  }
+  if (!part.t && ea.size() != eb.size()) {
+    const bool ref_longer = ea.size() > eb.size();
+    const Event& extra = ref_longer ? ea[n] : eb[n];
+    part.consider(extra.time, (ref_longer ? a : b) + " has " + std::to_string((ref_longer ? ea : eb).size() - n) +
+                                  " more event(s) from " + extra.name + " at t = " + short_number(extra.time));
+  }
+  // The reference's own warning: past it, event times are not fixed by the motion.
+  for (const auto* events : {&ea, &eb})
+    for (const Event& e : *events)
+      if (e.name == "unresolved") {
+        part.consider(e.time, "unresolved at t = " + short_number(e.time) + ": " + e.detail);
+        break;
+      }
+
+  // Runs that end differently.
+  if (reference.status != check.status)
+    part.consider(std::min(reference.status == "ok" ? check.status_time : reference.status_time,
+                           check.status == "ok" ? reference.status_time : check.status_time),
+                  a + " ends " + reference.status + ", " + b + " " + check.status +
+                      (check.status != "ok" ? " at t = " + short_number(check.status_time) + " (" +
+                                                  check.status_detail + ")"
+                                            : std::string()));
+
+  // The sampled state, on the common grid (both runs sample the same scene's grid).
+  const size_t m = std::min(ref_traj.size(), check_traj.size());
+  const double E0 = ref_traj.size() ? ref_traj.energy.front() : 1.0;
+  const double e_scale = std::isfinite(E0) && E0 != 0.0 ? std::abs(E0) : 1.0;
+  for (size_t k = 0; k < m; ++k) {
+    if (!(std::abs(ref_traj.t[k] - check_traj.t[k]) <= 0.5 * scene.run.sample_interval)) break;
+    if (part.t && ref_traj.t[k] > *part.t) break;
+    const double dth = std::abs(ref_traj.theta[k] - check_traj.theta[k]);
+    const double de = std::abs(ref_traj.energy[k] - check_traj.energy[k]) / e_scale;
+    if (dth <= kSelfCheckStateTolerance && de <= kSelfCheckStateTolerance) continue;
+    const double until = k ? ref_traj.t[k - 1] : 0.0;
+    const bool tilt = !(dth <= kSelfCheckStateTolerance);
+    part.consider(until, std::string(tilt ? "the tilt" : "the energy") + " differs by " +
+                             short_number(tilt ? dth : de) + (tilt ? " rad" : " E0") + " > " +
+                             short_number(kSelfCheckStateTolerance) + " at t = " + short_number(ref_traj.t[k]));
+    break;
+  }
+  sc.converged_until = part.t;
+  sc.reason = part.reason;
+  return sc;
+}
+
+SelfCheck run_self_check(const Scene& scene, const RunRecord& reference, const Trajectory& ref_traj) {
+  Scene second = scene;
+  const SelfCheckMethod plan = self_check_method(scene.run);
+  second.run.method = plan.method;
+  second.run.rtol = plan.rtol;
+  second.run.atol = plan.atol;
+  TrajectorySink sink;
+  const RunRecord check = run_scene(second, "analytic", &sink);
+  return compare_reference_runs(reference, ref_traj, check, sink.trajectory, scene);
+}
+
+json to_json(const SelfCheck& s) {
+  return json{{"method", s.method},
+              {"rtol", s.rtol},
+              {"atol", s.atol},
+              {"converged_until", number(s.converged_until)},
+              {"reason", s.reason},
+              {"cpu_seconds", number(s.cpu_seconds)}};
+}
+
+SelfCheck self_check_from_json(const json& j) {
+  SelfCheck s;
+  s.method = j.at("method").get<std::string>();
+  s.rtol = j.at("rtol").get<double>();
+  s.atol = j.value("atol", 0.0);
+  const json& cu = j.at("converged_until");
+  if (!cu.is_null()) {
+    const double t = cu.get<double>();
+    if (!(std::isfinite(t) && t >= 0))
+      throw std::invalid_argument("reference.self_check.converged_until: " + cu.dump() + " is not a time >= 0 or null");
+    s.converged_until = t;
+  }
+  s.reason = j.at("reason").get<std::string>();
+  s.cpu_seconds = get_number(j, "cpu_seconds");
+  return s;
+}
 
 // ---- records --------------------------------------------------------------------------------
 
@@ -348,6 +530,11 @@ json to_json(const Comparison& c) {
   }
   json provenance_with_versions = to_json(c.provenance);
   provenance_with_versions["engine_versions"] = versions;
+  json reference = {{"cached", c.reference_cached}, {"summary", summary_with_bounded_events(c.reference)}};
+  if (c.self_check) {
+    reference["self_check"] = to_json(*c.self_check);
+    reference["self_check"]["cached"] = c.self_check_cached;
+  }
   return json{
       {"format", "tippe-comparison-1"},
       {"scene_name", c.scene.value("name", "")},
@@ -356,7 +543,7 @@ json to_json(const Comparison& c) {
       {"physics_hash", physics_hash(c.scene)},
       {"scene", c.scene},
       {"provenance", provenance_with_versions},
-      {"reference", {{"cached", c.reference_cached}, {"summary", summary_with_bounded_events(c.reference)}}},
+      {"reference", reference},
       {"engines", engines},
   };
 }
@@ -394,6 +581,11 @@ Comparison comparison_from_json(const json& j) {
   c.provenance = provenance_from_json(j.at("provenance"));
   c.reference = from_json(j.at("reference").at("summary"));
   c.reference_cached = j.at("reference").at("cached").get<bool>();
+  // Absent (or null) in records of comparisons run without the self-check, and before it existed.
+  if (j.at("reference").contains("self_check") && !j.at("reference").at("self_check").is_null()) {
+    c.self_check = self_check_from_json(j.at("reference").at("self_check"));
+    c.self_check_cached = j.at("reference").at("self_check").value("cached", false);
+  }
   for (const json& e : j.at("engines")) c.engines.push_back({from_json(e.at("summary")), metrics_from_json(e.at("metrics"))});
   return c;
 }
@@ -517,6 +709,7 @@ class ProgressBoard {
 
 struct Task {
   std::string engine;
+  const Scene* scene = nullptr;  // the scene to run when not the comparison's (the self-check)
   std::string csv_path;  // "" = no file
   std::string cache_csv_path;  // reference only: a copy for the cache
   RunRecord record;
@@ -601,6 +794,45 @@ void copy_file_atomic(const fs::path& from, const fs::path& to) {
 
 std::string analytic_version(const Scene& scene) { return make_simulator("analytic", scene)->version(); }
 
+// DIR/self_check.json: the self-check of the reference cached beside it. Keyed by the physics
+// hash, the reference's provenance (commit, host, date: a summary rewritten by a later run no
+// longer matches) and the second method and tolerances, so a check made for another reference
+// or with another method is never taken for this one's.
+json self_check_key(const std::string& hash, const RunRecord& reference, const SelfCheckMethod& plan) {
+  return json{{"physics_hash", hash},
+              {"reference_git_commit", reference.provenance.git_commit},
+              {"reference_hostname", reference.provenance.hostname},
+              {"reference_date", reference.provenance.date},
+              {"method", plan.method},
+              {"rtol", plan.rtol},
+              {"atol", plan.atol}};
+}
+
+std::optional<SelfCheck> load_cached_self_check(const fs::path& dir, const std::string& hash,
+                                                const RunRecord& reference, const SelfCheckMethod& plan) {
+  if (dir.empty()) return std::nullopt;
+  try {
+    const json j = json::parse(read_file_text((dir / "self_check.json").string()));
+    if (j.at("format") != "tippe-self-check-1" || j.at("key") != self_check_key(hash, reference, plan))
+      return std::nullopt;
+    return self_check_from_json(j.at("self_check"));
+  } catch (const std::exception&) {
+    return std::nullopt;  // absent, partial or from elsewhere: run the check again
+  }
+}
+
+void store_self_check(const fs::path& dir, const std::string& hash, const RunRecord& reference,
+                      const SelfCheck& sc) {
+  const SelfCheckMethod plan{sc.method, sc.rtol, sc.atol};
+  const json j = {{"format", "tippe-self-check-1"}, {"key", self_check_key(hash, reference, plan)},
+                  {"self_check", to_json(sc)}};
+  try {
+    write_file_atomic((dir / "self_check.json").string(), j.dump(2) + "\n");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tippe: warning: reference self-check not cached: %s\n", e.what());
+  }
+}
+
 }  // namespace
 
 bool load_cached_reference(const fs::path& dir, const Scene& scene, const std::string& hash, RunRecord& record,
@@ -671,6 +903,7 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
   if (!out.empty()) fs::create_directories(out);
 
   std::vector<Task> tasks(options.engines.size() + 1);
+  tasks.reserve(tasks.size() + 1);  // room for the self-check: `ref` stays valid
   Task& ref = tasks[0];
   ref.engine = "analytic";
   if (!out.empty()) ref.csv_path = (out / "reference.csv").string();
@@ -694,8 +927,31 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
     if (!out.empty()) tasks[i + 1].csv_path = (out / (options.engines[i] + ".csv")).string();
   }
 
+  // The self-check: from the cache beside a cached reference, else a second reference run in
+  // parallel with the engines (it needs nothing from the first until both are done).
+  Scene check_scene = scene;
+  const SelfCheckMethod plan = self_check_method(scene.run);
+  check_scene.run.method = plan.method;
+  check_scene.run.rtol = plan.rtol;
+  check_scene.run.atol = plan.atol;
+  size_t check_slot = 0;  // 0: no self-check run
+  if (scene.run.self_check) {
+    if (c.reference_cached) {
+      if (auto cached = load_cached_self_check(cache_dir, hash, ref.record, plan)) {
+        c.self_check = *cached;
+        c.self_check_cached = true;
+      }
+    }
+    if (!c.self_check) {
+      check_slot = tasks.size();
+      tasks.emplace_back();
+      tasks.back().engine = "analytic";
+      tasks.back().scene = &check_scene;
+    }
+  }
+
   std::vector<std::string> names;
-  for (const Task& t : tasks) names.push_back(t.engine);
+  for (size_t i = 0; i < tasks.size(); ++i) names.push_back(i && i == check_slot ? "self-check" : tasks[i].engine);
   ProgressBoard board(scene.name, names, scene.run.duration);
   std::vector<size_t> todo;
   for (size_t i = 0; i < tasks.size(); ++i) {
@@ -711,7 +967,12 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
   std::function<void()> redraw;
   if (options.progress) redraw = [&] { board.print(); };
   parallel_for(
-      todo.size(), options.jobs, [&](size_t k) { run_task(tasks[todo[k]], scene, board, todo[k]); }, redraw);
+      todo.size(), options.jobs,
+      [&](size_t k) {
+        Task& t = tasks[todo[k]];
+        run_task(t, t.scene ? *t.scene : scene, board, todo[k]);
+      },
+      redraw);
   if (options.progress) {
     board.print();
     std::fputc('\n', stderr);
@@ -731,9 +992,20 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
     }
   }
 
+  if (check_slot) {
+    const Task& t = tasks[check_slot];
+    c.self_check = compare_reference_runs(ref.record, ref.trajectory, t.record, t.trajectory, scene);
+    // Beside a reference that is in the cache (loaded, or just written there).
+    if (!cache_dir.empty() && ref.record.status != to_string(RunStatus::Failed) &&
+        (c.reference_cached || !ref.cache_csv_path.empty()))
+      store_self_check(cache_dir, hash, ref.record, *c.self_check);
+  }
+  const std::optional<double> converged_until = c.self_check ? c.self_check->converged_until : std::nullopt;
+
   c.reference = ref.record;
   for (size_t i = 1; i < tasks.size(); ++i) {
-    Metrics m = compare_runs(ref.record, ref.trajectory, tasks[i].record, tasks[i].trajectory, scene);
+    if (i == check_slot) continue;
+    Metrics m = compare_runs(ref.record, ref.trajectory, tasks[i].record, tasks[i].trajectory, scene, converged_until);
     c.engines.push_back({std::move(tasks[i].record), m});
   }
 

@@ -101,6 +101,7 @@ struct Spec {
   std::optional<std::vector<std::string>> set;
   std::optional<double> duration;
   std::optional<bool> require_same_events;
+  std::optional<bool> allow_unconverged;
   std::map<std::string, double> max;
 };
 
@@ -143,9 +144,11 @@ class GateReader {
 
   Spec spec(const toml::table& t, const std::string& key, bool is_defaults) const {
     static const std::vector<std::string> check_keys = {"name",   "scene", "engine", "set", "duration",
-                                                        "status", "require_same_events", "max"};
+                                                        "status", "require_same_events", "allow_unconverged",
+                                                        "max"};
     static const std::vector<std::string> default_keys = {"scene",  "engine", "set", "duration",
-                                                          "status", "require_same_events", "max"};
+                                                          "status", "require_same_events", "allow_unconverged",
+                                                          "max"};
     keys(t, key, is_defaults ? default_keys : check_keys);
     Spec s;
     s.key = key;
@@ -174,6 +177,11 @@ class GateReader {
       const auto* b = n->as_boolean();
       if (!b) fail(key + ".require_same_events", "expected true or false, got " + toml_value_text(*n));
       s.require_same_events = b->get();
+    }
+    if (const toml::node* n = t.get("allow_unconverged")) {
+      const auto* b = n->as_boolean();
+      if (!b) fail(key + ".allow_unconverged", "expected true or false, got " + toml_value_text(*n));
+      s.allow_unconverged = b->get();
     }
     if (const toml::node* n = t.get("duration")) {
       s.duration = number(*n, key + ".duration");
@@ -332,6 +340,7 @@ GateFile load_gate_file(const std::string& path) {
     c.engine = s.engine ? *s.engine : *defaults.engine;
     c.status = s.status ? *s.status : defaults.status.value_or("ok");
     c.require_same_events = s.require_same_events ? *s.require_same_events : defaults.require_same_events.value_or(false);
+    c.allow_unconverged = s.allow_unconverged ? *s.allow_unconverged : defaults.allow_unconverged.value_or(false);
     c.duration = s.duration ? s.duration : defaults.duration;
     const std::string duration_key = origin(s, defaults, s.duration.has_value(), "duration");
 
@@ -406,6 +415,8 @@ std::string event_story(const std::string& which, const char* verb, const char* 
   if (which == "reference_only") return std::string("the reference ") + verb + ", the engine does not";
   if (which == "neither") return std::string("neither the engine nor the reference ") + verb;
   if (which == "both") return std::string("both have the ") + noun + "; the reference's is at t = 0, so no relative error";
+  if (which == "unconverged")
+    return std::string("not judged: the reference is not converged where the ") + noun + " is (or would be)";
   return "no event comparison";
 }
 
@@ -483,6 +494,53 @@ GateRow threshold_row(const Threshold& t, const Metrics& m) {
     if (!r.passed) r.message = t.metric + " " + compared(*r.value) + " > " + fmt(t.max);
   }
   return r;
+}
+
+// Metrics computed over the samples the reference and the engine have in common: cut at the end
+// of the reference's converged window.
+bool windowed_metric(const std::string& metric) {
+  static const std::set<std::string> names = {"tilt_max_error",         "tilt_rms_error",         "energy_max_error",
+                                              "contact_path_rms_error", "contact_path_max_error", "com_path_rms_error",
+                                              "com_path_max_error",     "latitude_rms_error",     "compared_until"};
+  return names.count(metric) > 0;
+}
+
+bool event_metric(const std::string& metric, std::string* which, const Metrics& m) {
+  if (metric.rfind("inversion_", 0) == 0) {
+    *which = m.inversion_event;
+    return true;
+  }
+  if (metric.rfind("stem_contact_", 0) == 0) {
+    *which = m.stem_contact_event;
+    return true;
+  }
+  return false;
+}
+
+// The rows of a check that runs past the end of the reference's converged window, marked and
+// (unless the check allows it) failed.
+void mark_unconverged(std::vector<GateRow>& rows, const Check& check, const Metrics& m) {
+  if (!m.reference_converged_until || !(*m.reference_converged_until < check.loaded.run.duration)) return;
+  const std::string x = fmt(*m.reference_converged_until);
+  const std::string why = "reference not converged after t = " + x + " (the check runs to t = " +
+                          fmt(check.loaded.run.duration) + ")";
+  for (GateRow& row : rows) {
+    std::string which;
+    const bool event = row.kind == GateRowKind::Events || (row.kind == GateRowKind::Threshold && event_metric(row.metric, &which, m));
+    if (row.kind == GateRowKind::Events) which = row.measured;
+    if (event) {
+      if (which != "unconverged") continue;  // the pairing was judged inside the window
+      row.measured = "unconverged";
+      row.passed = check.allow_unconverged;
+      row.message = row.passed ? "" : row.metric + ": " + why + "; the event is not judged";
+      continue;
+    }
+    if (row.kind != GateRowKind::Threshold || !windowed_metric(row.metric)) continue;
+    row.measured += " compared to t = " + x + " (reference converged)";
+    if (check.allow_unconverged) continue;  // judged on the window, and marked
+    row.passed = false;
+    row.message = row.metric + ": " + why + "; compared to t = " + x + " only";
+  }
 }
 
 bool rows_pass(const std::vector<GateRow>& rows) {
@@ -566,6 +624,7 @@ CheckResult evaluate_check(const Check& check, const RunRecord& reference, const
     r.rows.push_back(event_row("stem_contact_event", metrics.stem_contact_event, "reaches stem contact", "stem contact"));
   }
   for (const Threshold& t : check.max) r.rows.push_back(threshold_row(t, metrics));
+  mark_unconverged(r.rows, check, metrics);
   r.passed = rows_pass(r.rows);
   return r;
 }

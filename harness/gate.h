@@ -45,6 +45,9 @@ struct Check {
   std::vector<std::string> overrides;  // what load_scene gets: run.duration=... first, then `set`
   std::string status = "ok";           // required run status
   bool require_same_events = false;
+  // Whether a threshold may be judged on the reference's converged window when that ends before
+  // the check's duration (the reference's self-check, compare.h). false: such a row fails.
+  bool allow_unconverged = false;
   std::vector<Threshold> max;  // in gate_metrics() order; [defaults].max merged under the check's
   Scene loaded;                // the scene with every override applied (checked at load)
 };
@@ -63,7 +66,7 @@ struct GateFile {
 //    the gate file), engine (bullet | ode | mujoco), set (array of "KEY=VALUE" strings), duration
 //    (number > 0, overrides run.duration), status (a run status: ok, contact_lost, diverged,
 //    unphysical, clamped, failed; default ok), require_same_events (boolean, default false),
-//    max (table: gate metric -> finite number >= 0).
+//    max (table: gate metric -> finite number >= 0), allow_unconverged (boolean, default false).
 //  - [defaults] takes every check key but name; a check's own scalar wins, its `set` follows
 //    the defaults' (later overrides win), its `max` entries replace the defaults' per metric.
 //  - `set` may not name another engine's settings (engines.OTHER.*): they would not be used.
@@ -97,6 +100,13 @@ struct CheckResult {
 // Pure: the verdict of `check` on one engine's run against the reference and their metrics.
 // A threshold passes when |value| <= max; an absent value (an event error when one side lacks
 // the event, a Jellett drift on a surface never run on) or a NaN fails it, with the reason.
+// When the reference is converged only to t = X < the check's duration
+// (metrics.reference_converged_until), every row compared against the reference over samples
+// (tilt, energy error, paths, latitude, compared_until) says "compared to t = X (reference
+// converged)" and fails with "reference not converged after t = X", and an event pairing past X
+// is "unconverged" and fails; with allow_unconverged the rows are judged on the window instead
+// (an unconverged pairing passes), still marked. A gate that silently passed on a shorter window
+// than its author asked for would be weaker than it reads: shorten the duration or allow it.
 CheckResult evaluate_check(const Check& check, const RunRecord& reference, const RunRecord& engine,
                            const Metrics& metrics);
 // A check whose comparison could not be run (the reference failed, an output error): it fails

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include "compare.h"
 #include "gnuplot.h"
@@ -89,6 +90,7 @@ Cell event_error_cell(const json& comparison, const json& metrics, const std::st
   const std::string which = str(metrics, (key + "_event").c_str());
   if (which == "reference_only") return {"missing", Grade::Bad};
   if (which == "engine_only") return {"extra", Grade::Bad};
+  if (which == "unconverged") return {"unconverged", Grade::Warn};
   if (which != "both") return {"-", Grade::None};
   const double abs_err = num(metrics, (key + "_time_abs_error").c_str());
   const double rel_err = num(metrics, (key + "_time_rel_error").c_str());
@@ -169,7 +171,7 @@ long long switch_count(const json& summary) {
 // Everything in Metrics that the summary leaves out.
 Table detail_table(const json& c) {
   Table t;
-  t.header = {"engine",         "compared to t",   "tilt max (rad)",    "E final/E0",      "E gain events",
+  t.header = {"engine",         "compared to t",   "reference converged to t", "tilt max (rad)",    "E final/E0",      "E gain events",
               "max gain (/E0)", "contact path max (/R)", "G path RMS (/R)", "G path max (/R)", "latitude RMS (rad)",
               "Jellett ball",   "Jellett stem",    "surface switches",  "wall s",          "real-time factor"};
   for (const json& e : c.at("engines")) {
@@ -180,6 +182,11 @@ Table detail_table(const json& c) {
     const long long gains = m.value("energy_gain_events", 0LL);
     t.rows.push_back({{str(e, "engine")},
                       cell("compared_until", "%.6g"),
+                      {m.contains("reference_converged_until")
+                           ? (has_number(m, "reference_converged_until") ? fmt(num(m, "reference_converged_until"), "%.6g")
+                                                                         : std::string("whole run"))
+                           : std::string("unchecked"),
+                       has_number(m, "reference_converged_until") ? Grade::Warn : Grade::None},
                       cell("tilt_max_error"),
                       cell("energy_final_ratio", "%.6g"),
                       {std::to_string(gains), gains > 0 ? Grade::Bad : Grade::None},
@@ -259,6 +266,27 @@ std::string provenance_lines(const json& c, const char* sep) {
 }
 
 std::string run_time_text(const json& s) { return fmt(num(s, "final_time"), "%.6g"); }
+
+// What the reference's self-check found: {headline, detail}. The headline is said at the top of
+// the report when the reference is converged over less than the whole run; the detail line
+// (which methods, the cost) is said with the reference in every case.
+std::pair<std::string, std::string> self_check_lines(const json& c) {
+  const json& r = c.at("reference");
+  if (!r.contains("self_check") || !r.at("self_check").is_object())
+    return {"", "Reference self-check: not run (run.self_check = false or --no-self-check, or a record from before it)."};
+  const json& sc = r.at("self_check");
+  const std::string a = str(c.at("scene").value("run", json::object()), "method");
+  const std::string b = str(sc, "method") == a ? str(sc, "method") + " at rtol " + fmt(num(sc, "rtol"), "%g")
+                                               : str(sc, "method");
+  const std::string cost = "CPU " + fmt(num(sc, "cpu_seconds"), "%.3g") + " s" + (sc.value("cached", false) ? ", cached" : "");
+  if (!has_number(sc, "converged_until"))
+    return {"", "Reference self-check: " + a + " and " + b + " agree over the whole run (" + cost + ")."};
+  const std::string x = fmt(num(sc, "converged_until"), "%.6g");
+  return {"The reference is converged to t = " + x + " (methods " + a + " and " + b + " part: " + str(sc, "reason") +
+              "); metrics are compared up to it.",
+          "Reference self-check: " + a + " against " + b + ", converged to t = " + x + " of " +
+              run_time_text(r.at("summary")) + " (" + cost + ")."};
+}
 
 // ---- plots ----------------------------------------------------------------------------------
 
@@ -434,6 +462,7 @@ std::string render_summary_table(const json& comparison) { return markdown_table
 std::vector<std::string> report_findings(const json& c) {
   std::vector<std::string> out;
   const json& ref = c.at("reference").at("summary");
+  if (const std::string unconverged = self_check_lines(c).first; !unconverged.empty()) out.push_back(unconverged);
   if (str(ref, "status") != "ok")
     out.push_back("reference: status " + str(ref, "status") + " at t = " + fmt(num(ref, "status_time"), "%.6g") +
                   ": " + str(ref, "status_detail"));
@@ -485,10 +514,12 @@ std::string render_summary_line(const json& c) {
 std::string render_markdown(const json& c) {
   const json& scene = c.at("scene");
   std::string s = "# Comparison: " + str(c, "scene_name") + "\n\n";
+  const auto [check_headline, check_detail] = self_check_lines(c);
+  if (!check_headline.empty()) s += "**" + check_headline + "**\n\n";
   if (!str(scene, "description").empty()) s += str(scene, "description") + "\n\n";
   const json& ref = c.at("reference").at("summary");
   s += "Reference: " + str(ref, "engine_version") + ", run to t = " + run_time_text(ref) +
-       (c.at("reference").value("cached", false) ? " (from the cache)" : "") + ".\n\n";
+       (c.at("reference").value("cached", false) ? " (from the cache)" : "") + ". " + check_detail + "\n\n";
   s += render_summary_table(c);
   s += "\nErrors are engine minus reference on the common sample grid; E0 is the reference's initial energy, R the "
        "ball radius.\n";
@@ -546,11 +577,14 @@ figcaption { font-size: 0.9em; color: #555; }
 details { margin: 0.4em 0; } summary { cursor: pointer; font-weight: bold; }
 footer { margin-top: 2em; font-size: 0.85em; color: #555; border-top: 1px solid #ccc; }
 .note { color: #555; font-style: italic; }
+.unconverged { background: #fde5a6; padding: 0.4em 0.6em; border-left: 4px solid #d9a400; }
 </style>
 </head>
 <body>
 )";
   h += "<h1>" + html_escape(name + ": engines against the analytic reference") + "</h1>\n";
+  const auto [check_headline, check_detail] = self_check_lines(c);
+  if (!check_headline.empty()) h += "<p class=\"unconverged\"><strong>" + html_escape(check_headline) + "</strong></p>\n";
   if (!str(scene, "description").empty()) h += "<p>" + html_escape(str(scene, "description")) + "</p>\n";
 
   h += "<h2>Scene</h2>\n<table class=\"params\">\n<tbody>\n";
@@ -567,7 +601,8 @@ footer { margin-top: 2em; font-size: 0.85em; color: #555; border-top: 1px solid 
   const json& ref = c.at("reference").at("summary");
   h += "<h2>Summary</h2>\n";
   h += "<p>Reference: " + html_escape(str(ref, "engine_version")) + ", run to t = " + html_escape(run_time_text(ref)) +
-       (c.at("reference").value("cached", false) ? " (from the cache)" : "") + ".</p>\n";
+       (c.at("reference").value("cached", false) ? " (from the cache)" : "") + ". " + html_escape(check_detail) +
+       "</p>\n";
   h += "<div class=\"wide\">\n" + html_table(summary_table(c), "summary") + "</div>\n";
   h += "<p class=\"note\">Errors are engine minus reference on the common sample grid (to the end of the shorter "
        "run); E0 is the reference's initial energy, R the ball radius. Event errors: green below 1 %, amber below "

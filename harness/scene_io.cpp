@@ -415,7 +415,7 @@ class Interpreter {
   }
 
   void read_run(const toml::table& t, RunSpec& r) const {
-    keys(t, "run", {"duration", "sample_interval", "rtol", "atol", "method"});
+    keys(t, "run", {"duration", "sample_interval", "rtol", "atol", "method", "self_check"});
     r.duration = need_positive(t, "run", "duration");
     r.sample_interval = need_number(t, "run", "sample_interval");
     if (!(r.sample_interval > 0 && r.sample_interval <= r.duration))
@@ -440,6 +440,7 @@ class Interpreter {
       if (r.method != "bulirsch_stoer" && r.method != "dopri5" && r.method != "rosenbrock4")
         fail("run.method", "must be \"bulirsch_stoer\", \"dopri5\" or \"rosenbrock4\", got \"" + r.method + "\"");
     }
+    r.self_check = opt_bool(t, "run", "self_check").value_or(true);
   }
 
   SettingValue to_setting(const toml::node& n, const std::string& path) const {
@@ -590,7 +591,8 @@ nlohmann::json scene_to_json(const Scene& s) {
         {"sample_interval", s.run.sample_interval},
         {"rtol", s.run.rtol},
         {"atol", s.run.atol},
-        {"method", s.run.method}}},
+        {"method", s.run.method},
+        {"self_check", s.run.self_check}}},
       {"engines", engines},
   };
 }

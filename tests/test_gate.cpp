@@ -221,7 +221,9 @@ TEST(GateMetrics, AreTheNumericMetricsButWallClock) {
   std::set<std::string> expected;
   const json all = to_json(Metrics{});
   for (const auto& [k, v] : all.items())
-    if (!v.is_string() && k != "wall_seconds" && k != "cpu_seconds" && k != "real_time_factor") expected.insert(k);
+    if (!v.is_string() && k != "wall_seconds" && k != "cpu_seconds" && k != "real_time_factor" &&
+        k != "reference_converged_until")  // the reference's, not the engine's: it marks rows instead
+      expected.insert(k);
   std::set<std::string> names;
   for (const GateMetric& g : gate_metrics()) EXPECT_TRUE(names.insert(g.name).second) << g.name << " listed twice";
   EXPECT_EQ(names, expected);
@@ -775,4 +777,73 @@ TEST(GateCommand, ShippedDefaultGatesPass) {
                            tmp.path());
   EXPECT_EQ(e.code, 0) << e.out << e.err;
   EXPECT_NE(e.out.find("gate: 6 of 6 checks passed"), std::string::npos) << e.out;
+}
+
+// ---- the reference's self-check ---------------------------------------------------------------
+
+TEST(GateEvaluate, AWindowPastTheConvergedReferenceFailsUnlessAllowed) {
+  Check c = fixture_check();
+  c.loaded.run.duration = 23.0;
+  c.require_same_events = true;
+  Metrics m = fixture_metrics();
+  m.reference_converged_until = 21.37;
+  m.compared_until = 21.37;
+  m.stem_contact_event = "unconverged";
+  CheckResult r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.27), m);
+  EXPECT_FALSE(r.passed);
+  const GateRow* tilt = row(r, "tilt_rms_error");
+  ASSERT_NE(tilt, nullptr);
+  EXPECT_FALSE(tilt->passed);
+  EXPECT_NE(tilt->measured.find("compared to t = 21.37 (reference converged)"), std::string::npos) << tilt->measured;
+  EXPECT_NE(tilt->message.find("reference not converged after t = 21.37"), std::string::npos) << tilt->message;
+  // The inversion (t = 17.25) is inside the window: judged as usual.
+  EXPECT_TRUE(row(r, "inversion_time_rel_error")->passed);
+  EXPECT_TRUE(row(r, "inversion_event")->passed);
+  EXPECT_FALSE(row(r, "stem_contact_event")->passed);
+  EXPECT_NE(row(r, "stem_contact_event")->message.find("reference not converged after t = 21.37"), std::string::npos);
+  EXPECT_TRUE(row(r, "energy_gain_events")->passed);  // the engine's own: the whole run
+  const std::string junit = render_junit({r}, "suite");
+  EXPECT_NE(junit.find("reference not converged after t = 21.37"), std::string::npos);
+  EXPECT_NE(render_table({r}).find("compared to t = 21.37 (reference converged)"), std::string::npos);
+
+  c.allow_unconverged = true;
+  r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.27), m);
+  EXPECT_TRUE(r.passed) << render_table({r});
+  EXPECT_NE(row(r, "tilt_rms_error")->measured.find("compared to t = 21.37"), std::string::npos);
+  EXPECT_EQ(row(r, "stem_contact_event")->measured, "unconverged");
+
+  // A window that reaches the check's end, or no self-check at all: nothing is marked.
+  c.allow_unconverged = false;
+  c.loaded.run.duration = 21.0;
+  m.stem_contact_event = "both";
+  r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.27), m);
+  EXPECT_EQ(row(r, "tilt_rms_error")->measured.find("compared to"), std::string::npos);
+  m.reference_converged_until.reset();
+  r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.27), m);
+  EXPECT_TRUE(row(r, "tilt_rms_error")->passed);
+}
+
+TEST(GateFile, AllowUnconvergedIsABooleanMergedFromDefaults) {
+  TempDir d{"tippe-gate"};
+  d.write("fixture.toml", slurp(kSource + "/harness/scenes/toy.toml"));
+  const GateFile g = load_gate_file(d.write("g.toml", R"(
+[defaults]
+scene = "fixture.toml"
+engine = "ode"
+allow_unconverged = true
+[[check]]
+name = "a"
+[[check]]
+name = "b"
+allow_unconverged = false
+)"));
+  ASSERT_EQ(g.checks.size(), 2u);
+  EXPECT_TRUE(g.checks[0].allow_unconverged);
+  EXPECT_FALSE(g.checks[1].allow_unconverged);
+  try {
+    load_gate_file(d.write("bad.toml", "[[check]]\nname = \"a\"\nscene = \"fixture.toml\"\nengine = \"ode\"\nallow_unconverged = 1\n"));
+    FAIL() << "a number for allow_unconverged loaded";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("check[0].allow_unconverged: expected true or false"), std::string::npos) << e.what();
+  }
 }
