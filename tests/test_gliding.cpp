@@ -142,6 +142,40 @@ TEST(Gliding, NoGrazeAndNoSlipEvents) {
   EXPECT_EQ(m.graze_fraction_range().first, std::numeric_limits<double>::infinity());
 }
 
+// The toy top under the gliding law (mu = 0.46 s/m, about k / (M g) of toy_viscous): it inverts,
+// touches down on its stem, passes the cascade of impacts to a hold and a phase on both
+// contacts. The ledger (friction work at each contact, impacts, hold, projections) closes to
+// 1e-9 E0 through all of it, and both methods touch down at the same time.
+TEST(Gliding, StemTouchdownAndTwoContactsKeepTheLedger) {
+  const std::vector<std::string> set = {"contact.friction=\"gliding\"", "contact.k=0", "contact.mu=0.46"};
+  Scene s = load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/toy_viscous.toml", set);
+  ASSERT_EQ(s.contact.friction, FrictionLaw::Gliding);
+  std::optional<double> touchdown[2];
+  for (int method = 0; method < 2; ++method) {
+    if (method == 1) s.run.method = "dopri5";
+    ReferenceModel m(s);
+    const BodyModel& b = m.body();
+    const double e0 = energy(b, m.state());
+    double worst = 0.0;
+    for (int k = 1; k <= 120; ++k) {
+      m.advance_to(s.run.duration * k / 120);
+      ASSERT_EQ(m.status(), ReferenceStatus::Ok) << m.status_detail();
+      worst = std::max(worst, std::abs(energy(b, m.state()) + m.energy_ledger().total() - e0) / e0);
+    }
+    touchdown[method] = first_event(m.events(), "stem_contact");
+    ASSERT_TRUE(touchdown[method].has_value());
+    EXPECT_TRUE(first_event(m.events(), "two_contact").has_value());
+    EXPECT_FALSE(first_event(m.events(), "graze").has_value());
+    const EnergyLedger l = m.energy_ledger();
+    std::printf("toy top, gliding, %s: stem touchdown %.10f s, ledger residual %.3g E0 (friction %.4f, impacts %.4f, "
+                "holds %.4f, projections %.3g E0)\n",
+                s.run.method.c_str(), *touchdown[method], worst, l.friction / e0, l.impacts / e0, l.holds / e0,
+                l.projections / e0);
+    EXPECT_LT(worst, 1e-9);
+  }
+  EXPECT_NEAR(*touchdown[1], *touchdown[0], 1e-7 * *touchdown[0]);
+}
+
 // ---- the engines, with the bench's explicit gliding force (F_n of the previous step) ---------
 
 double engine_inversion(const std::string& engine, const Scene& scene) {
