@@ -156,6 +156,14 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
       if (dir.dot(slot.slip_dir_W) < 0) dir = -dir;
       fdir -= c_.mu * dir;
     }
+    if (c_.friction == FrictionLaw::Gliding) {
+      // Rutstam's gliding law F_t = -mu F_n v_C (mu in s/m): unlike the viscous force it scales
+      // with the unknown normal force, so it rides on the normal column (sliding Coulomb with
+      // mu v_C in place of mu v_C/|v_C|) and enters the normal row's coupling through K. It is
+      // smooth through zero slip (no slip events) and vanishes with F_n, so "held" and "lifted"
+      // join continuously where F_n reaches 0: a contact lifts there, it never grazes.
+      fdir -= c_.mu * slip;
+    }
     if (slot.graze) {
       // Zero normal force and the given share of the viscous force; no constraint.
       idx[s].graze = true;
@@ -292,7 +300,10 @@ BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touchi
   };
   // Tangential impulses: rolling stops the whole contact velocity; Coulomb tries that and,
   // outside the cone, slides along the pre-impact slip; viscous and none have no impulsive
-  // friction (a finite force transmits no impulse).
+  // friction (a finite force transmits no impulse). Gliding friction is left out of impacts
+  // too (normal impulse only): strictly its force -mu F_n v_C follows an impulsive F_n with
+  // the impulse -mu integral(v_C dP_n), a simplification of this model that matters only where
+  // a gliding top touches down (the bare ball never does).
   const bool full_stop = !normal_only && (c_.friction == FrictionLaw::Rolling || c_.friction == FrictionLaw::Coulomb);
 
   struct Solution {

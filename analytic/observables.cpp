@@ -12,6 +12,7 @@ const char* to_string(FrictionLaw law) {
     case FrictionLaw::Viscous: return "viscous";
     case FrictionLaw::Coulomb: return "coulomb";
     case FrictionLaw::None: return "none";
+    case FrictionLaw::Gliding: return "gliding";
   }
   return "?";
 }

@@ -915,6 +915,17 @@ ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene
       impl_->failure_hint = os.str();
     }
   }
+  if (scene.contact.friction == FrictionLaw::Gliding && scene.contact.mu > 0 && scene.run.method != "rosenbrock4") {
+    // The gliding slip relaxes in about 1 / (mu g (1 + M R^2 / A)) (F_n ~ M g): stiff likewise
+    // for a large mu.
+    const double relax = 1.0 / (scene.contact.mu * body_.g * (1.0 + body_.M * body_.R * body_.R / body_.A));
+    if (relax < 1e-3 * period) {
+      std::ostringstream os;
+      os << " (the gliding slip relaxes in 1 / (mu g (1 + M R^2 / A)) = " << relax << ", " << period / relax
+         << " times faster than the motion: stiff for " << scene.run.method << "; run.method = \"rosenbrock4\" is made for it)";
+      impl_->failure_hint = os.str();
+    }
+  }
   const StateVector y0 = pack(x0);
   ContactMode none;
   impl_->y_obs = y0;

@@ -9,7 +9,7 @@
 
 namespace tippe {
 
-enum class FrictionLaw { Rolling, Viscous, Coulomb, None };
+enum class FrictionLaw { Rolling, Viscous, Coulomb, None, Gliding };
 enum class MassModel { Seed, Solid, Given };
 
 const char* to_string(FrictionLaw law);
@@ -37,7 +37,7 @@ struct MassProperties {
 
 struct ContactSpec {
   FrictionLaw friction = FrictionLaw::Coulomb;
-  double mu = 0.0;        // Coulomb coefficient
+  double mu = 0.0;        // Coulomb coefficient; gliding (Rutstam 2012): F_t = -mu F_n v_C, mu in s/m
   double k = 0.0;         // viscous coefficient, F_t = -k v_C
   double drilling = 0.0;  // torsional friction length mu_d: |tau| <= mu_d F_n
   bool stem = true;       // false: a bare eccentric ball

@@ -191,6 +191,7 @@ struct BulletObjects {
 struct ContactSum {
   bool ball = false, stem = false;
   double impulse = 0.0;
+  double impulse_ball = 0.0, impulse_stem = 0.0;  // the parts of impulse on each geom
   Vec3 moment = Vec3::Zero();
   double max_point_impulse = 0.0;
 };
@@ -256,9 +257,10 @@ BulletSimulator::BulletSimulator(const Scene& scene)
   switch (c.friction) {
     case FrictionLaw::Coulomb: mu_ = c.mu; break;
     case FrictionLaw::Rolling: mu_ = settings_.rolling_mu; break;
-    // Viscous: the base class applies F_t = -k v_C through apply_force_W; Bullet's own contact
-    // must then be frictionless.
+    // Viscous and gliding: the base class applies F_t = -k v_C or -mu F_n v_C through
+    // apply_force_W; Bullet's own contact must then be frictionless.
     case FrictionLaw::Viscous:
+    case FrictionLaw::Gliding:
     case FrictionLaw::None: mu_ = 0; break;
   }
   // Spinning friction is Bullet's torsional row: |tau| <= spinning * normal impulse per point,
@@ -393,6 +395,9 @@ void BulletSimulator::make_notes() {
                      " (written into each contact point: Bullet's own product of the two frictions is capped at 10)");
   if (sc.contact.friction == FrictionLaw::Viscous)
     notes_.push_back("viscous friction applied by the bench as an external force at the geometric contact point; Bullet contacts frictionless");
+  if (sc.contact.friction == FrictionLaw::Gliding)
+    notes_.push_back("gliding friction -mu F_n v_C applied by the bench as an external force at each geometric contact point, "
+                     "F_n per geom from Bullet's previous scene step (explicit); Bullet contacts frictionless");
   if (frictional && settings_.friction_directions == 2)
     notes_.push_back("Coulomb friction as a box in two tangent directions (first along the slip velocity), each bounded by mu P_n: "
                      "the friction force can exceed mu F_n by up to sqrt(2)");
@@ -458,6 +463,9 @@ void BulletSimulator::engine_step() {
   r.stem = sum.stem;
   // Mean normal force over the scene step: the impulses of all internal steps over dt.
   r.normal_force = sum.impulse / settings_.timestep;
+  // Per geom likewise: what the gliding law takes as each contact's F_n for the next step.
+  r.normal_force_ball = sum.impulse_ball / settings_.timestep;
+  r.normal_force_stem = sum.impulse_stem / settings_.timestep;
   if (sum.impulse > 0) {
     r.point_valid = true;
     r.p_WC = sum.moment / sum.impulse;
@@ -500,8 +508,10 @@ void BulletSimulator::collect_contacts(ContactSum& sum) const {
       const btManifoldPoint& cp = m->getContactPoint(j);
       const double P = cp.getAppliedImpulse();
       if (!(cp.getDistance() <= touch_gap || P > 0)) continue;
-      (is_stem_point(cp, body_is_0) ? sum.stem : sum.ball) = true;
+      const bool stem = is_stem_point(cp, body_is_0);
+      (stem ? sum.stem : sum.ball) = true;
       if (P > 0) {
+        (stem ? sum.impulse_stem : sum.impulse_ball) += P;
         // The floor-side point, as the collision pass placed it before this step's solve.
         const btVector3& p_W = body_is_0 ? cp.getPositionWorldOnB() : cp.getPositionWorldOnA();
         sum.impulse += P;

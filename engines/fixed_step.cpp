@@ -1,6 +1,8 @@
-// Shared stepping loop of the fixed-step engines: events, failure classification, viscous law, work.
+// Shared stepping loop of the fixed-step engines: events, failure classification, viscous and
+// gliding laws, work.
 #include "fixed_step.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -72,6 +74,25 @@ void FixedStepSimulator::step_once() {
       Vec3 v_C = x.v_WG + w_W.cross(R_C);
       v_C.z() = 0.0;
       apply_force_W(-scene_.contact.k * v_C, x.p_WG + R_C);
+    }
+  }
+  if (scene_.contact.friction == FrictionLaw::Gliding) {
+    // Rutstam's gliding law F_t = -mu F_n v_C at every contact the engine has, each with its own
+    // normal force, contact point and velocity (the engine's own contact is frictionless in this
+    // mode). The normal force is the engine's from the previous step (the report describes the
+    // step just taken): an explicit law, first order in dt, as the engine's solve cannot carry
+    // a friction proportional to the force it is solving for. Before the first step it is the
+    // report of the initial state (0 where the engine has not solved yet: one step without
+    // friction).
+    const ContactReport c = engine_contacts();
+    const Vec3 w_W = x.q_WB * x.w_B;
+    for (const Surface s : {Surface::Ball, Surface::Stem}) {
+      if (!(s == Surface::Ball ? c.ball : c.stem && body_.stem)) continue;
+      const double f_n = std::max(0.0, s == Surface::Ball ? c.normal_force_ball : c.normal_force_stem);
+      const Vec3 R_C = contact_offset_W(body_, x.q_WB, s);
+      Vec3 v_C = x.v_WG + w_W.cross(R_C);
+      v_C.z() = 0.0;
+      apply_force_W(-scene_.contact.mu * f_n * v_C, x.p_WG + R_C);
     }
   }
   engine_step();

@@ -1,4 +1,5 @@
-// Shared stepping loop of the fixed-step engines: events, failure classification, viscous law, work.
+// Shared stepping loop of the fixed-step engines: events, failure classification, viscous and
+// gliding laws, work.
 #pragma once
 
 #include <string>
@@ -14,6 +15,8 @@ struct ContactReport {
   bool ball = false;               // the engine has a contact on the ball geom
   bool stem = false;               // ... on the stem geom
   double normal_force = 0.0;       // sum of normal forces on the body (N or scene units)
+  double normal_force_ball = 0.0;  // the part of normal_force on the ball geom
+  double normal_force_stem = 0.0;  // ... on the stem geom
   bool point_valid = false;
   Vec3 p_WC = Vec3::Zero();        // engine's contact point (force-weighted mean when several)
 };
@@ -36,7 +39,7 @@ class FixedStepSimulator : public Simulator {
   std::vector<Event> events() const override { return events_; }
 
   // Benchmarks only: n engine steps with none of the adapter's work (no events, checks,
-  // observations or viscous forces), to measure the adapter's overhead against the bare engine.
+  // observations or viscous/gliding forces), to measure the adapter's overhead against the bare engine.
   void bare_steps(long long n) {
     for (long long i = 0; i < n; ++i) engine_step();
   }

@@ -56,7 +56,7 @@ struct MujocoSettings {
   std::vector<double> solref = {0.002, 1.0};
   // [dmin, dmax, width, midpoint, power]: MuJoCo's default impedance profile.
   std::vector<double> solimp = {0.9, 0.95, 0.001, 0.5, 2.0};
-  // 0: derived from the scene's friction law (1 none/viscous, 3 coulomb/rolling, 4 with
+  // 0: derived from the scene's friction law (1 none/viscous/gliding, 3 coulomb/rolling, 4 with
   // drilling); 1, 3, 4 or 6 force that contact dimensionality (diagnostic).
   int condim = 0;
   // Friction coefficient that stands in for the rolling constraint (friction = rolling).
@@ -143,9 +143,10 @@ int derived_condim(const Scene& scene) {
   switch (c.friction) {
     case FrictionLaw::Coulomb: return c.mu > 0 ? 3 : 1;
     case FrictionLaw::Rolling: return 3;
-    // Viscous: the base class applies F_t = -k v_C through apply_force_W, so the engine's own
-    // contact must be frictionless.
+    // Viscous and gliding: the base class applies F_t = -k v_C or -mu F_n v_C through
+    // apply_force_W, so the engine's own contact must be frictionless.
     case FrictionLaw::Viscous:
+    case FrictionLaw::Gliding:
     case FrictionLaw::None: return 1;
   }
   return 1;
@@ -416,6 +417,9 @@ void MujocoSimulator::make_notes(const std::string& compiler_warning) {
                      std::to_string(settings_.noslip_iterations_rolling) + " noslip iterations");
   if (c.friction == FrictionLaw::Viscous)
     notes_.push_back("viscous friction applied by the bench as an external force (mj_applyFT) at the geometric contact point; MuJoCo contacts frictionless");
+  if (c.friction == FrictionLaw::Gliding)
+    notes_.push_back("gliding friction -mu F_n v_C applied by the bench as an external force (mj_applyFT) at each geometric contact point, "
+                     "F_n per geom from MuJoCo's previous step (mj_contactForce, explicit); MuJoCo contacts frictionless");
   if (c.friction == FrictionLaw::Coulomb && !(c.mu > 0) && settings_.condim == 0)
     notes_.push_back("Coulomb friction with mu = 0 simulated as frictionless contact (condim 1)");
   if (condim_ >= 3 && (c.friction == FrictionLaw::Coulomb || c.friction == FrictionLaw::Rolling) &&
@@ -531,6 +535,7 @@ ContactReport MujocoSimulator::read_contacts() const {
     // In the contact frame, whose first axis is the normal (+z here): f[0] is the normal force.
     mj_contactForce(m_, d_, i, f);
     r.normal_force += f[0];
+    (g == ball_id_ ? r.normal_force_ball : r.normal_force_stem) += f[0];
     if (f[0] > 0) {
       // c.pos lies midway between the two surfaces: within the penetration depth of the floor.
       moment += f[0] * Vec3(c.pos[0], c.pos[1], c.pos[2]);
@@ -590,6 +595,14 @@ std::vector<std::string> mujoco_mjcf_missing(const Scene& scene) {
     out.push_back("the viscous friction F_t = -k v_C (k = " + k.str() +
                   ") that the bench applies each step as an external force at every contact: the model's contacts "
                   "are frictionless, so in plain MuJoCo the top only spins");
+  }
+  if (c.friction == FrictionLaw::Gliding && c.mu > 0) {
+    std::ostringstream mu;
+    mu.imbue(std::locale::classic());
+    mu << c.mu;
+    out.push_back("the gliding friction F_t = -mu F_n v_C (mu = " + mu.str() +
+                  " s/m) that the bench applies each step as an external force at every contact, with the engine's "
+                  "previous normal force: the model's contacts are frictionless, so in plain MuJoCo the top only spins");
   }
   return out;
 }

@@ -331,9 +331,10 @@ dSurfaceParameters OdeSimulator::make_surface() const {
   switch (c.friction) {
     case FrictionLaw::Coulomb: s.mu = c.mu; break;
     case FrictionLaw::Rolling: s.mu = settings_.rolling_mu; break;
-    // Viscous: the base class applies F_t = -k v_C through apply_force_W; the engine's own
-    // contact must then be frictionless.
+    // Viscous and gliding: the base class applies F_t = -k v_C or -mu F_n v_C through
+    // apply_force_W; the engine's own contact must then be frictionless.
     case FrictionLaw::Viscous:
+    case FrictionLaw::Gliding:
     case FrictionLaw::None: s.mu = 0; break;
   }
   s.mode = dContactSoftERP | dContactSoftCFM;
@@ -372,6 +373,9 @@ void OdeSimulator::make_notes() {
                      (approx1 ? " (coefficient, approx1)" : " (force bound, box)"));
   if (sc.contact.friction == FrictionLaw::Viscous)
     notes_.push_back("viscous friction applied by the bench as an external force at the geometric contact point; ODE contacts frictionless");
+  if (sc.contact.friction == FrictionLaw::Gliding)
+    notes_.push_back("gliding friction -mu F_n v_C applied by the bench as an external force at each geometric contact point, "
+                     "F_n per geom from ODE's previous step (joint feedback, explicit); ODE contacts frictionless");
   if (!approx1 && (sc.contact.friction == FrictionLaw::Coulomb || sc.contact.friction == FrictionLaw::Rolling))
     notes_.push_back("friction_model = box: mu is a constant force bound per friction direction, not a coefficient");
   if (approx1 && sc.contact.friction == FrictionLaw::Coulomb)
@@ -442,6 +446,7 @@ void OdeSimulator::engine_step() {
     // The floor normal is +z and the tangent rows are horizontal: f1.z is the normal force.
     const double f_n = c.feedback.f1[2];
     r.normal_force += f_n;
+    (c.stem ? r.normal_force_stem : r.normal_force_ball) += f_n;
     moment += f_n * c.p_W;
   }
   if (r.normal_force > 0) {

@@ -166,7 +166,8 @@ bool energy_must_not_rise(const Scene& scene) {
   if (c.friction == FrictionLaw::None) return false;
   if (c.drilling > 0) return true;
   // A law whose coefficient is zero removes nothing: rises there are noise, not injected energy.
-  return (c.friction == FrictionLaw::Viscous && c.k > 0) || (c.friction == FrictionLaw::Coulomb && c.mu > 0);
+  return (c.friction == FrictionLaw::Viscous && c.k > 0) || (c.friction == FrictionLaw::Coulomb && c.mu > 0) ||
+         (c.friction == FrictionLaw::Gliding && c.mu > 0);
 }
 
 Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, const RunRecord& engine,

@@ -280,14 +280,16 @@ class Interpreter {
   void read_contact(const toml::table& t, ContactSpec& c) const {
     keys(t, "contact", {"friction", "mu", "k", "drilling", "stem", "flight"});
     const auto law = opt_string(t, "contact", "friction");
-    if (!law) fail("contact.friction", "missing (required: rolling, viscous, coulomb or none)");
+    if (!law) fail("contact.friction", "missing (required: rolling, viscous, gliding, coulomb or none)");
     if (*law == "rolling") c.friction = FrictionLaw::Rolling;
     else if (*law == "viscous") c.friction = FrictionLaw::Viscous;
+    else if (*law == "gliding") c.friction = FrictionLaw::Gliding;
     else if (*law == "coulomb") c.friction = FrictionLaw::Coulomb;
     else if (*law == "none") c.friction = FrictionLaw::None;
-    else fail("contact.friction", "unknown law \"" + *law + "\" (expected rolling, viscous, coulomb or none)");
+    else fail("contact.friction", "unknown law \"" + *law + "\" (expected rolling, viscous, gliding, coulomb or none)");
 
-    if (c.friction == FrictionLaw::Coulomb) {
+    if (c.friction == FrictionLaw::Coulomb || c.friction == FrictionLaw::Gliding) {
+      // Coulomb: dimensionless; gliding: F_t = -mu F_n v_C, mu in s/m (Rutstam 2012).
       c.mu = need_number(t, "contact", "mu");
       // No upper bound on mu or k: large values are how a scene approaches rolling.
       if (!(c.mu >= 0)) out_of_range("contact.mu", c.mu, "mu >= 0");

@@ -42,8 +42,9 @@ class SceneError : public std::runtime_error {
 //    compute_mass_properties(body); or all four of mass, com_offset, inertia_transverse,
 //    inertia_axial (MassModel::Given; density and mass_model must then be absent), with
 //    M, A, C > 0, |d| < R and C <= 2A.
-//  - friction laws: coulomb needs mu >= 0, viscous needs k >= 0. A coefficient of another law
-//    (mu with viscous, k with coulomb, ...) is accepted only when it is 0, so one template can
+//  - friction laws: coulomb needs mu >= 0 (dimensionless), viscous needs k >= 0 (F_t = -k v_C,
+//    N s/m), gliding needs mu >= 0 (F_t = -mu F_n v_C, Rutstam 2012: mu in s/m). A coefficient
+//    of another law (mu with viscous, k with coulomb or gliding, ...) is accepted only when it is 0, so one template can
 //    carry every key without silently changing the physics; drilling (>= 0) applies to every
 //    law but "none", where it too must be 0.
 //  - initial: rolling derives the velocity of G, so initial.velocity is rejected with it;

@@ -228,6 +228,24 @@ TEST(Bullet, ViscousForceActsForOneStepOnly) {
   EXPECT_TRUE(noted);
 }
 
+// Gliding friction is the bench's force as well: Bullet's contact points stay frictionless and
+// the force is gone after its step.
+TEST(Bullet, GlidingLeavesBulletContactsFrictionless) {
+  Scene scene = dimensionless_scene();
+  scene.contact.friction = FrictionLaw::Gliding;
+  scene.contact.mu = 0.3;
+  const auto sim = make_simulator("bullet", scene);
+  const double e0 = sim->observe().energy;
+  sim->advance_to(1.0);
+  ASSERT_EQ(sim->status(), RunStatus::Ok) << sim->status_detail();
+  const BulletReadback r = bullet_readback(*sim);
+  EXPECT_EQ(r.total_force_W.norm(), 0.0);
+  EXPECT_EQ(r.total_torque_W.norm(), 0.0);
+  EXPECT_FALSE(r.point_friction.empty());
+  for (double mu : r.point_friction) EXPECT_EQ(mu, 0.0);
+  EXPECT_LT(sim->observe().energy, e0 + 1e-6);  // as for the viscous law above
+}
+
 // rolling_mu = 1e3 must reach the solver: Bullet's own combination would cap it at 10.
 TEST(Bullet, RollingMuReachesTheContactPoints) {
   Scene scene = dimensionless_scene();

@@ -228,6 +228,11 @@ TEST(Metrics, DissipativeLaws) {
   EXPECT_TRUE(energy_must_not_rise(s));
   s.contact.mu = 0;
   EXPECT_FALSE(energy_must_not_rise(s));
+  s.contact.friction = FrictionLaw::Gliding;  // F_t = -mu F_n v_C removes energy when mu > 0
+  EXPECT_FALSE(energy_must_not_rise(s));
+  s.contact.mu = 0.3;
+  EXPECT_TRUE(energy_must_not_rise(s));
+  s.contact.mu = 0;
   s.contact.friction = FrictionLaw::Rolling;
   EXPECT_FALSE(energy_must_not_rise(s));
   s.contact.drilling = 0.01;

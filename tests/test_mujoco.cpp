@@ -222,6 +222,12 @@ TEST(Mujoco, CondimFollowsTheFrictionLaw) {
   s.contact.friction = FrictionLaw::Viscous;
   s.contact.k = 1.0;
   EXPECT_EQ(condim(s), "1");
+  // Gliding friction is the bench's force too: MuJoCo's contact stays frictionless.
+  s.contact.friction = FrictionLaw::Gliding;
+  s.contact.k = 0.0;
+  s.contact.mu = 0.3;
+  EXPECT_EQ(condim(s), "1");
+  s.contact.mu = 0.0;
   s.contact.friction = FrictionLaw::Rolling;
   s.contact.k = 0.0;
   const auto sim = make_mujoco_simulator(s);

@@ -110,6 +110,13 @@ std::vector<BadScene> bad_scenes() {
       {"viscous_without_k", edit(b, "k = 1.0\n", ""), {}, {": contact.k: missing"}, {}},
       {"coulomb_without_mu", edit(b, "\"viscous\"\nk = 1.0", "\"coulomb\""), {}, {": contact.mu: missing"}, {}},
       {"k_with_coulomb", edit(b, "\"viscous\"", "\"coulomb\"\nmu = 0.3"), {}, {": contact.k: does not apply"}, {}},
+      // Gliding (F_t = -mu F_n v_C, mu in s/m) takes mu as Coulomb does and refuses k.
+      {"gliding_without_mu", edit(b, "\"viscous\"\nk = 1.0", "\"gliding\""), {}, {": contact.mu: missing"}, {}},
+      {"k_with_gliding", edit(b, "\"viscous\"", "\"gliding\"\nmu = 0.3"), {},
+       {": contact.k: does not apply to friction = \"gliding\" (only 0 is accepted), got 1"}, {}},
+      {"negative_gliding_mu", edit(b, "\"viscous\"\nk = 1.0", "\"gliding\"\nmu = -0.3"), {},
+       {": contact.mu: -0.3 is out of range (expected mu >= 0)"}, {}},
+      {"mu_with_viscous", edit(b, "k = 1.0", "k = 1.0\nmu = 0.3"), {}, {": contact.mu: does not apply to friction = \"viscous\""}, {}},
       {"rolling_with_velocity", rolling, {}, {": initial.velocity: ", "derived for rolling"}, {}},
       {"spin_and_omega", edit(b, "spin = 5.0", "spin = 5.0\nomega = [0.0, 0.0, 5.0]"), {}, {": initial.omega: ", "not both"}, {}},
       {"neither_spin_nor_omega", edit(b, "spin = 5.0\n", ""), {}, {": initial.spin: missing"}, {}},
@@ -211,6 +218,20 @@ TEST(SceneIo, ValidSceneParses) {
   EXPECT_EQ(j.at("mass_properties").at("inertia_axial").get<double>(), 0.45);
   EXPECT_EQ(j.at("contact").at("friction").get<std::string>(), "viscous");
   EXPECT_EQ(j.at("engines").at("ode").at("iterations").get<long long>(), 20);
+}
+
+// The gliding law: mu (s/m) read, k = 0 accepted (a template may carry every key), the law named
+// "gliding" in the JSON.
+TEST(SceneIo, GlidingParses) {
+  TempDir dir{"tippe-test"};
+  const std::string text = edit(kBase, "friction = \"viscous\"\nk = 1.0", "friction = \"gliding\"\nmu = 0.3\nk = 0");
+  const Scene s = load_scene(dir.write("gliding.toml", text));
+  EXPECT_EQ(s.contact.friction, FrictionLaw::Gliding);
+  EXPECT_EQ(s.contact.mu, 0.3);
+  EXPECT_EQ(s.contact.k, 0.0);
+  EXPECT_EQ(scene_to_json(s).at("contact").at("friction").get<std::string>(), "gliding");
+  // mu = 0 is the frictionless limit, accepted as for Coulomb.
+  EXPECT_EQ(load_scene(dir.write("gliding0.toml", edit(text, "mu = 0.3", "mu = 0"))).contact.mu, 0.0);
 }
 
 TEST(SceneIo, OptionalKeysAndOmega) {
