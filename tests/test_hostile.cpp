@@ -103,8 +103,10 @@ std::vector<std::string> strings(const toml::table& t, const char* key, const st
 void keys(const toml::table& t, const std::string& where, std::initializer_list<const char*> allowed) {
   for (auto&& [k, v] : t) {
     (void)v;
-    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return k.str() == a; }))
-      bad(where + "." + std::string(k.str()), "unknown key");
+    // A copy: C++17 lambdas cannot capture a structured binding (clang refuses it).
+    const std::string key(k.str());
+    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; }))
+      bad(where + "." + key, "unknown key");
   }
 }
 

@@ -302,7 +302,7 @@ std::vector<FileCase> file_cases() {
       {"stem_an_integer", S, edit(b, "k = 1.0", "k = 1.0\nstem = 1"), "contact.stem",
        "expected true or false, got an integer 1"},
       {"unknown_run_key", S, edit(b, "atol = 1e-12", "atol = 1e-12\ntolerance = 1e-9"), "run.tolerance",
-       "unknown key (expected one of: duration, sample_interval, rtol, atol, method)"},
+       "unknown key (expected one of: duration, sample_interval, rtol, atol, method, self_check)"},
       {"set_rtol_out_of_range", S, b, "run.rtol", "0.5 is out of range (expected 1e-15 <= rtol <= 0.01)",
        {"run.rtol=0.5"}, true},
       {"engine_timestep_out_of_range", S, b + "[engines.ode]\ntimestep = 1\n", "engines.ode.timestep",
