@@ -20,6 +20,7 @@
 //                     (also '/'), that must / must not exist after the last step (in a
 //                     [[case.step]]: after that step)
 //   temporaries       false when *.tmp.* files may be left (default true: none may be)
+//   sanitized         false for a case too long under ASan/UBSan (default true); skipped there
 // Placeholders in path, content, set, args, exists and absent: {dir} the case's directory,
 // {source} the source root, {0xHH} the byte HH (a path that is not UTF-8), {range:N:TEXT} TEXT N
 // times joined by ", " with '#' counting 1..N (a large input). Every step runs with
@@ -79,6 +80,7 @@ struct Case {
   std::vector<Step> steps;
   Checks checks;
   bool temporaries = true;
+  bool sanitized = true;
 };
 
 // A malformed cases file is a failure of every test that reads it, with its reason.
@@ -183,9 +185,10 @@ std::vector<Case> load_cases() {
     if (!names.emplace(c.name, i).second) bad(w + ".name", c.name + " is also case[" + std::to_string(names[c.name]) + "]");
     if (const toml::node* n = t->get("issue"); n && n->is_string()) c.issue = n->as_string()->get();
     c.files = files_of(*t, w);
-    keys(*t, w, {"name", "issue", "file", "step", "exists", "absent", "contains", "temporaries"});
+    keys(*t, w, {"name", "issue", "file", "step", "exists", "absent", "contains", "temporaries", "sanitized"});
     c.checks = checks_of(*t, w);
     if (const toml::node* n = t->get("temporaries")) c.temporaries = n->value_or(true);
+    if (const toml::node* n = t->get("sanitized")) c.sanitized = n->value_or(true);
     const toml::array* steps = t->get("step") ? t->get("step")->as_array() : nullptr;
     if (!steps || steps->empty()) bad(w + ".step", "no [[case.step]] tables");
     for (size_t k = 0; k < steps->size(); ++k) {
@@ -367,8 +370,23 @@ void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
 class Hostile : public ::testing::TestWithParam<Case> {};
 
+// Whether this build runs under AddressSanitizer (scripts/sanitize.sh), where the reference is
+// tens of times slower.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
 TEST_P(Hostile, Case) {
   const Case& c = GetParam();
+  if (kSanitized && !c.sanitized) GTEST_SKIP() << "too long under the sanitizers (sanitized = false)";
   if (!c.issue.empty()) RecordProperty("issue", c.issue);
   TempDir tmp("tippe-hostile");
   const fs::path dir = fs::canonical(tmp.path());
