@@ -91,6 +91,17 @@ struct BulletSettings {
   bool velocity_friction_direction = true;
   // Friction coefficient that stands in for the rolling constraint (friction = rolling).
   double rolling_mu = 1e3;
+  // The stem's collision shape: a capsule from O to P (what a user models as the stem), or the
+  // sphere of radius r at P alone (the reference's stem contact). Their lowest points agree at
+  // every tilt (the capsule's other end lies inside the ball); Bullet's support-point routines
+  // differ, hence a choice to sweep.
+  std::string stem_shape = "capsule";
+  // Bullet's contact breaking threshold relative to the body's size: a manifold point is kept
+  // (and matched to the next step's point, carrying its warm-start impulse) while it stays within
+  // this fraction of the compound's angular motion disc (~ its bounding radius). Bullet's default
+  // is gContactBreakingThreshold = 0.02 with CD_USE_RELATIVE_CONTACT_BREAKING_THRESHOLD, i.e.
+  // 0.02 x the disc: the value here. A length-scale choice of the engine, not physics.
+  double contact_breaking_threshold = 0.02;
 
   template <class V>
   void visit(V& v) {
@@ -110,6 +121,8 @@ struct BulletSettings {
     v("friction_directions", friction_directions, 1, 2);
     v("velocity_friction_direction", velocity_friction_direction);
     v("rolling_mu", rolling_mu, 0.0, 1e15);
+    v("stem_shape", stem_shape, {"capsule", "tip_sphere"});
+    v("contact_breaking_threshold", contact_breaking_threshold, 0.0, 1.0);
   }
 };
 
@@ -160,6 +173,18 @@ class TopWorld : public btDiscreteDynamicsWorld {
   }
 };
 
+// The body's compound shape with its own contact breaking threshold: Bullet asks each shape for
+// it (getContactBreakingThreshold) when it makes a manifold, so the setting is per simulator,
+// unlike the process-wide gContactBreakingThreshold that threads of a sweep share.
+class TopShape : public btCompoundShape {
+ public:
+  explicit TopShape(double breaking_factor) : breaking_factor_(breaking_factor) {}
+  btScalar getContactBreakingThreshold(btScalar) const override { return getAngularMotionDisc() * breaking_factor_; }
+
+ private:
+  double breaking_factor_;
+};
+
 // Owns one simulator's Bullet objects; destroyed world first (its destructor still walks the
 // bodies' broadphase proxies), then bodies, shapes, solver, broadphase, dispatcher.
 struct BulletObjects {
@@ -169,8 +194,8 @@ struct BulletObjects {
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver;
   std::unique_ptr<btStaticPlaneShape> floor_shape;
   std::unique_ptr<btSphereShape> ball_shape;
-  std::unique_ptr<btCapsuleShapeZ> stem_shape;
-  std::unique_ptr<btCompoundShape> body_shape;
+  std::unique_ptr<btConvexInternalShape> stem_shape;  // btCapsuleShapeZ or btSphereShape
+  std::unique_ptr<TopShape> body_shape;
   std::unique_ptr<btRigidBody> floor;
   std::unique_ptr<btRigidBody> body;
   std::unique_ptr<TopWorld> world;
@@ -290,13 +315,17 @@ BulletSimulator::BulletSimulator(const Scene& scene)
   // Sphere and capsule are Bullet's implicit shapes (all radius is margin): their surfaces are
   // exact, unlike a hull. The ball is a full sphere about O = G + d e_Z: the cap cut at h is not
   // modelled (see notes).
-  o_.body_shape = std::make_unique<btCompoundShape>();
+  o_.body_shape = std::make_unique<TopShape>(settings_.contact_breaking_threshold);
   o_.ball_shape = std::make_unique<btSphereShape>(m.R);
   btTransform child;
   child.setIdentity();
   child.setOrigin(btVector3(0, 0, m.z_O()));
   o_.body_shape->addChildShape(child, o_.ball_shape.get());  // child index 0
-  if (m.stem) {
+  if (m.stem && settings_.stem_shape == "tip_sphere") {
+    o_.stem_shape = std::make_unique<btSphereShape>(m.r);
+    child.setOrigin(btVector3(0, 0, m.z_P()));
+    o_.body_shape->addChildShape(child, o_.stem_shape.get());  // child index 1
+  } else if (m.stem) {
     // Bullet's capsule height is the segment between the cap centres, centred on its origin:
     // O to P is the segment, so the origin sits at the middle, d + l/2.
     o_.stem_shape = std::make_unique<btCapsuleShapeZ>(m.r, m.l);
@@ -556,14 +585,22 @@ BulletReadback BulletSimulator::readback() const {
   r.ball_radius = static_cast<const btSphereShape*>(shape->getChildShape(0))->getRadius();
   r.has_stem = shape->getNumChildShapes() > 1;
   if (r.has_stem) {
-    const auto* capsule = static_cast<const btCapsuleShape*>(shape->getChildShape(1));
+    const btCollisionShape* stem = shape->getChildShape(1);
     const btTransform& T = shape->getChildTransform(1);
-    btVector3 up(0, 0, 0);
-    up[capsule->getUpAxis()] = 1;
     r.stem_centre_B = to_eigen(T.getOrigin());
-    r.stem_axis_B = to_eigen(T.getBasis() * up);
-    r.stem_radius = capsule->getRadius();
-    r.stem_half_length = capsule->getHalfHeight();
+    if (stem->getShapeType() == CAPSULE_SHAPE_PROXYTYPE) {
+      const auto* capsule = static_cast<const btCapsuleShape*>(stem);
+      btVector3 up(0, 0, 0);
+      up[capsule->getUpAxis()] = 1;
+      r.stem_axis_B = to_eigen(T.getBasis() * up);
+      r.stem_radius = capsule->getRadius();
+      r.stem_half_length = capsule->getHalfHeight();
+    } else {
+      // The tip sphere: a segment of length 0 at P along the body's axis.
+      r.stem_axis_B = to_eigen(T.getBasis() * btVector3(0, 0, 1));
+      r.stem_radius = static_cast<const btSphereShape*>(stem)->getRadius();
+      r.stem_half_length = 0;
+    }
   }
   r.body_friction = b->getFriction();
   r.floor_friction = o_.floor->getFriction();

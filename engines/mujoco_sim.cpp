@@ -72,6 +72,12 @@ struct MujocoSettings {
   // term, d w3 |w_perp| in the friction rows (1.8 m/s^2 on the toy top), holds a false slip that
   // turns Coulomb tops over ten times early.
   std::string body_frame = "ball_centre";
+  // The stem's collision shape: a capsule from O to P (what a user models as the stem; the
+  // tutorial's is a cylinder), or the sphere of radius r at P alone (the reference's stem
+  // contact). Their lowest points agree at every tilt (the capsule's other end lies inside the
+  // ball); MuJoCo's capsule-plane routine may still add a second contact at that end within the
+  // margin, and the two shapes' contact frames differ, hence a choice to sweep.
+  std::string stem_shape = "capsule";
 
   template <class V>
   void visit(V& v) {
@@ -90,6 +96,7 @@ struct MujocoSettings {
     v("condim", condim, 0, 6);
     v("rolling_mu", rolling_mu, 0.0, 1e15);
     v("body_frame", body_frame, {"com", "ball_centre"});
+    v("stem_shape", stem_shape, {"capsule", "tip_sphere"});
   }
 };
 
@@ -248,7 +255,10 @@ std::string build_mjcf(const Scene& scene, const MujocoSettings& s) {
   // The ball is a full sphere about O = G + d e_Z: the cap cut at h is not modelled.
   os << "      <geom name=\"ball\" type=\"sphere\" size=\"" << num(m.R) << "\" pos=\"" << vec({0.0, 0.0, m.z_O() - z0})
      << "\" contype=\"2\" conaffinity=\"1\"/>\n";
-  if (m.stem)
+  if (m.stem && s.stem_shape == "tip_sphere")
+    os << "      <geom name=\"stem\" type=\"sphere\" size=\"" << num(m.r) << "\" pos=\""
+       << vec({0.0, 0.0, m.z_P() - z0}) << "\" contype=\"2\" conaffinity=\"1\"/>\n";
+  else if (m.stem)
     os << "      <geom name=\"stem\" type=\"capsule\" size=\"" << num(m.r) << "\" fromto=\""
        << vec({0.0, 0.0, m.z_O() - z0, 0.0, 0.0, m.z_P() - z0}) << "\" contype=\"2\" conaffinity=\"1\"/>\n";
   os << "    </body>\n";

@@ -72,6 +72,11 @@ struct OdeSettings {
   int seed = 0;
   // Per geom pair: sphere-plane gives 1 contact, capsule-plane at most 2; 4 leaves headroom.
   int max_contacts = 4;
+  // The stem's collision shape: a capsule from O to P (what a user models as the stem), or the
+  // sphere of radius r at P alone (the reference's stem contact). Their lowest points are the
+  // same at every tilt (the capsule's other end lies inside the ball), so the physics is the
+  // same; ODE's capsule-plane and sphere-plane routines are not, hence a choice to sweep.
+  std::string stem_shape = "capsule";
   // "approx1": mu is a coefficient (|F_t| <= mu F_n, from the normal force of the same solve).
   // "box": mu is a constant force bound (ODE's plain default), a different law; diagnostic.
   std::string friction_model = "approx1";
@@ -93,6 +98,7 @@ struct OdeSettings {
     v("gyroscopic", gyroscopic);
     v("seed", seed, 0, INT_MAX);
     v("max_contacts", max_contacts, 1, 64);
+    v("stem_shape", stem_shape, {"capsule", "tip_sphere"});
     v("friction_model", friction_model, {"approx1", "box"});
     v("rolling_mu", rolling_mu, 0.0, 1e15);
   }
@@ -296,10 +302,16 @@ OdeSimulator::OdeSimulator(const Scene& scene)
   dGeomSetBody(ball_, body_);
   dGeomSetOffsetPosition(ball_, 0, 0, m.z_O());
   if (m.stem) {
-    // ODE capsules lie along local Z with `length` between the cap centres: O to P.
-    stem_ = dCreateCapsule(space_, m.r, m.l);
-    dGeomSetBody(stem_, body_);
-    dGeomSetOffsetPosition(stem_, 0, 0, m.z_O() + 0.5 * m.l);
+    if (settings_.stem_shape == "tip_sphere") {
+      stem_ = dCreateSphere(space_, m.r);
+      dGeomSetBody(stem_, body_);
+      dGeomSetOffsetPosition(stem_, 0, 0, m.z_P());
+    } else {
+      // ODE capsules lie along local Z with `length` between the cap centres: O to P.
+      stem_ = dCreateCapsule(space_, m.r, m.l);
+      dGeomSetBody(stem_, body_);
+      dGeomSetOffsetPosition(stem_, 0, 0, m.z_O() + 0.5 * m.l);
+    }
   }
 
   const BodyState x0 = scene_initial_state(scene);

@@ -307,6 +307,20 @@ bool larger_is_softer(const std::string& ladder_key);
 // the first point out of the reference's regime; -1 when even the finest disagrees or there are
 // no points. Indices into `records`.
 long long softest_agreeing(const std::vector<SweepRecord>& records);
+// Where the reference does not invert and a time-step ladder's runs leave its regime (they
+// invert): how that departure behaves as the step shrinks, read from the finished runs (status
+// ok) finest last. "goes away": the finest runs are in the regime (from `in_regime_from` down);
+// "moves later": every finished run inverts and the inversion time grows as the step falls (each
+// finer run inverts no earlier than 1 % before the next coarser one); "stays": every finished run
+// inverts and the time does not grow; "none": no finished run leaves the regime; "mixed": the
+// regime comes and goes along the ladder; "-": not a time-step ladder, the reference inverts, or
+// fewer than two finished runs. The answer holds up to the runs' horizon only.
+struct RegimeTrend {
+  std::string verdict;
+  std::optional<double> in_regime_from;                   // the coarsest step of the finest run of agreeing points
+  std::vector<std::pair<double, double>> inversion_by_step;  // (step, inversion time), coarsest first
+};
+RegimeTrend regime_trend(const std::vector<SweepRecord>& records);
 
 // The text of an axis value of a record: the number as %g, else the label.
 std::string ladder_text(const SweepRecord& r);

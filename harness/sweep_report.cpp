@@ -160,6 +160,52 @@ long long softest_agreeing(const std::vector<SweepRecord>& records) {
   return softest;
 }
 
+RegimeTrend regime_trend(const std::vector<SweepRecord>& records) {
+  RegimeTrend out{"-", std::nullopt, {}};
+  if (records.empty() || records.front().reference_inversion_time) return out;
+  const std::string& key = records.front().ladder_key;
+  if (key.substr(key.rfind('.') == std::string::npos ? 0 : key.rfind('.') + 1) != "timestep") return out;
+  // Finished runs only: a run that diverged or was clamped says nothing about when a stable run
+  // of that step would leave the regime.
+  std::vector<const SweepRecord*> ok;
+  for (const SweepRecord& r : records)
+    if (r.status == "ok" && std::isfinite(r.ladder_value)) ok.push_back(&r);
+  if (ok.size() < 2) return out;
+  std::stable_sort(ok.begin(), ok.end(),
+                   [](const SweepRecord* a, const SweepRecord* b) { return a->ladder_value > b->ladder_value; });
+  for (const SweepRecord* r : ok)
+    if (r->inversion_time) out.inversion_by_step.emplace_back(r->ladder_value, *r->inversion_time);
+  if (out.inversion_by_step.empty()) {
+    out.verdict = "none";
+    return out;
+  }
+  // The finest runs in the regime, walking from the finest up to the first that inverts.
+  size_t k = ok.size();
+  while (k > 0 && !ok[k - 1]->inversion_time) --k;
+  if (k < ok.size()) out.in_regime_from = ok[k]->ladder_value;
+  // Between the coarsest inverting run and the agreeing tail, every run must invert for the
+  // departure to be one thing that moves with the step.
+  size_t first = 0;
+  while (!ok[first]->inversion_time) ++first;
+  for (size_t i = first; i < k; ++i)
+    if (!ok[i]->inversion_time) {
+      out.verdict = "mixed";
+      return out;
+    }
+  if (out.in_regime_from) {
+    out.verdict = "goes away";
+    return out;
+  }
+  // 1 %: an inversion time read off samples of the run moves by a sample or two between runs
+  // that are the same physics; a later time by more than that is the departure moving.
+  bool later = true;
+  for (size_t i = first + 1; i < k; ++i)
+    later = later && *ok[i]->inversion_time >= 0.99 * *ok[i - 1]->inversion_time;
+  const bool grows = *ok[k - 1]->inversion_time > 1.01 * *ok[first]->inversion_time;
+  out.verdict = later && grows ? "moves later" : "stays";
+  return out;
+}
+
 // ---- report -----------------------------------------------------------------------------------
 
 namespace {
@@ -173,6 +219,17 @@ std::string g3(double v) { return std::isfinite(v) ? fmt("%.3g", v) : "-"; }
 std::string pct(double v) { return std::isfinite(v) ? fmt("%.3g", 100 * v) + " %" : "-"; }
 std::string pct(const std::optional<double>& v) { return v ? pct(*v) : "-"; }
 std::string time_text(const std::optional<double>& t) { return t ? fmt("%.6g", *t) : "none"; }
+
+// The regime table's last column: the verdict and the inversion times it rests on.
+std::string trend_text(const RegimeTrend& tr) {
+  if (tr.verdict == "-" || tr.verdict == "none") return tr.verdict;
+  std::string times;
+  for (const auto& [dt, t] : tr.inversion_by_step)
+    times += (times.empty() ? "" : ", ") + fmt("%.3g", t) + " at " + fmt("%.3g", dt);
+  std::string text = tr.verdict;
+  if (tr.in_regime_from) text += " (in the regime from dt = " + fmt("%.3g", *tr.in_regime_from) + " down)";
+  return text + "; inverts at " + times;
+}
 std::string last_part(const std::string& key) { return key.substr(key.rfind('.') + 1); }
 std::string setting_text(const SweepRecord& r) {
   return r.ladder_key + " = " + ladder_text(r) + (r.grid_key.empty() ? "" : ", " + r.grid_key + " = " + grid_text(r));
@@ -645,10 +702,18 @@ void scene_section(const SceneGroup& s, const std::vector<std::string>& images, 
                      ". For each setup, the softest setting (largest time step or tolerance, fewest iterations) "
                      "reached from the finest one before the first point whose regime differs from the "
                      "reference's" +
-                     (s.reference_inversion ? " (no inversion)" : " (it inverts, or the run ends early)") + ".",
+                     (s.reference_inversion ? " (no inversion)" : " (it inverts, or the run ends early)") +
+                     ". Every verdict here holds up to the runs' horizon, t = " + fmt("%.4g", s.duration) +
+                     (s.reference_inversion
+                          ? "."
+                          : "; for a time-step ladder, the last column says whether leaving the reference's regime "
+                            "goes away as the step shrinks (the finest runs roll), only moves later (every finished "
+                            "run inverts, later at a smaller step), or stays."),
                  {},
                  {}});
-  Table reg{{"setup", "engine", "softest setting in the reference's regime", "points out of the regime"}, {}};
+  Table reg{{"setup", "engine", "softest setting in the reference's regime", "points out of the regime",
+             "as the step shrinks"},
+            {}};
   for (const SetupGroup& u : s.setups)
     for (const Line& l : lines_of(u)) {
       const long long k = softest_agreeing(l.points);
@@ -666,7 +731,7 @@ void scene_section(const SceneGroup& s, const std::vector<std::string>& images, 
                           choices ? "- (a ladder of choices)"
                           : k >= 0 ? setting_text(l.points[static_cast<size_t>(k)])
                                    : "none (even the finest disagrees)",
-                          out.empty() ? "none" : out});
+                          out.empty() ? "none" : out, trend_text(regime_trend(l.points))});
     }
   doc.push_back({Block::Tab, "", reg, {}});
 

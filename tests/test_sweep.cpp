@@ -342,6 +342,45 @@ TEST(SweepAnalysis, SoftestSettingInTheReferencesRegime) {
   EXPECT_EQ(softest_agreeing(it), 1);
 }
 
+// Leaving the reference's rolling regime, as the step shrinks: gone at the finest steps, moved
+// later, or staying; a diverged run is left out; "mixed" when the regime comes and goes.
+TEST(SweepAnalysis, RegimeTrendAlongTheStep) {
+  auto point = [](double dt, std::optional<double> inversion, const std::string& status = "ok") {
+    SweepRecord r;
+    r.ladder_key = "engines.ode.timestep";
+    r.ladder_value = dt;
+    r.inversion_time = inversion;
+    r.status = status;
+    return r;
+  };
+  // ODE on toy to 30 s as measured (4.87 s at 3e-4, 13.2 s at 1e-4, none at 3e-5).
+  RegimeTrend tr = regime_trend({point(1e-3, 1.84), point(3e-4, 4.87), point(1e-4, 13.2), point(3e-5, std::nullopt)});
+  EXPECT_EQ(tr.verdict, "goes away");
+  ASSERT_TRUE(tr.in_regime_from);
+  EXPECT_EQ(*tr.in_regime_from, 3e-5);
+  ASSERT_EQ(tr.inversion_by_step.size(), 3u);
+  EXPECT_EQ(tr.inversion_by_step.front().first, 1e-3) << "coarsest first";
+  // Every finished run inverts, later as the step falls: the departure only moves.
+  tr = regime_trend({point(1e-4, 9.0), point(1e-3, 2.0), point(3e-4, 5.0), point(3e-2, 0.1, "diverged")});
+  EXPECT_EQ(tr.verdict, "moves later") << "sorted by step, the diverged run left out";
+  EXPECT_FALSE(tr.in_regime_from);
+  // The same time at every step (MuJoCo's frame at G on toy: 1.309 s throughout).
+  EXPECT_EQ(regime_trend({point(1e-3, 1.309), point(1e-4, 1.309), point(2e-5, 1.31)}).verdict, "stays");
+  // Earlier at a finer step: not "moves later".
+  EXPECT_EQ(regime_trend({point(1e-3, 5.0), point(1e-4, 2.0)}).verdict, "stays");
+  EXPECT_EQ(regime_trend({point(1e-3, std::nullopt), point(1e-4, std::nullopt)}).verdict, "none");
+  EXPECT_EQ(regime_trend({point(1e-3, 2.0), point(3e-4, std::nullopt), point(1e-4, 3.0), point(3e-5, std::nullopt)}).verdict,
+            "mixed");
+  // Not answerable: one finished run; the reference inverts; not a time step.
+  EXPECT_EQ(regime_trend({point(1e-3, 2.0), point(1e-4, 2.0, "diverged")}).verdict, "-");
+  SweepRecord inv = point(1e-3, 4.0);
+  inv.reference_inversion_time = 4.3;
+  EXPECT_EQ(regime_trend({inv, inv}).verdict, "-");
+  SweepRecord iters = point(10, 2.0);
+  iters.ladder_key = "engines.ode.iterations";
+  EXPECT_EQ(regime_trend({iters, iters}).verdict, "-");
+}
+
 TEST(SweepReport, MarkdownNamesTheCheapestPointsAndOrders) {
   std::vector<SweepRecord> recs;
   const std::vector<double> h = {1e-2, 1e-3, 1e-4};
