@@ -4,18 +4,14 @@
 
 #include "../analytic/reference_model.h"
 #include "adapters.h"
+#include "settings.h"
 #include "timing.h"
 
 namespace tippe {
 
 namespace {
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(17);
-  os << v;
-  return os.str();
-}
+std::string num(double v) { return round_trip_text(v); }
 
 class AnalyticSimulator final : public Simulator {
  public:

@@ -132,12 +132,7 @@ Vec3 to_eigen(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
 btQuaternion to_bt(const Quat& q) { return btQuaternion(q.x(), q.y(), q.z(), q.w()); }
 Quat to_eigen(const btQuaternion& q) { return Quat(q.w(), q.x(), q.y(), q.z()); }
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(17);
-  os << v;
-  return os.str();
-}
+std::string num(double v) { return round_trip_text(v); }
 
 // Coefficients the solver must see in every body-floor contact point.
 struct ContactMaterial {

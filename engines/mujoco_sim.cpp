@@ -104,14 +104,7 @@ struct MujocoSettings {
   throw std::invalid_argument("engines.mujoco." + key + ": " + why);
 }
 
-std::string num(double v) {
-  if (v == 0.0) v = 0.0;  // "-0" reads as 0 anyway; keep the text plain
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
-  os.precision(17);
-  os << v;
-  return os.str();
-}
+std::string num(double v) { return round_trip_text(v); }
 
 // Settings that are valid one by one but not together (MuJoCo would silently clamp them).
 void check_combination(const MujocoSettings& s) {

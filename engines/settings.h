@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -13,6 +15,20 @@
 #include "simulator.h"
 
 namespace tippe {
+
+// The shortest text that reads back as exactly v ("0.2", not "0.20000000000000001"): what a
+// record or a model file needs to reproduce a number, without the digits it does not have.
+// printf's %g at the fewest significant digits that read back exactly: "0.0001" rather than the
+// shortest "1e-04", as people write it.
+inline std::string round_trip_text(double v) {
+  if (v == 0.0) v = 0.0;  // "-0" reads as 0 anyway; keep the text plain
+  char buf[64];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
 
 // Applies the entries of one [engines.NAME] table to a settings struct. The struct exposes
 //   template <class V> void visit(V& v) { v("timestep", timestep); ... }
@@ -114,12 +130,7 @@ class SettingsLister {
 
  private:
   void put(const char* key, std::string v) { list.emplace_back(key, std::move(v)); }
-  static std::string num(double v) {
-    std::ostringstream os;
-    os.precision(17);
-    os << v;
-    return os.str();
-  }
+  static std::string num(double v) { return round_trip_text(v); }
 };
 
 template <class Settings>

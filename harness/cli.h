@@ -1,6 +1,7 @@
 // Shared pieces of the `tippe` subcommands: how one registers, how errors map to exit codes.
 #pragma once
 
+#include <algorithm>
 #include <exception>
 #include <functional>
 #include <iostream>
@@ -60,6 +61,35 @@ inline int error_exit(const std::exception_ptr& e, bool print = true) {
 }
 
 // One function per subcommand, each in its own cli_NAME.cpp; main.cpp lists them.
+// The name in `names` nearest to `word` by edit distance (insertions, deletions, substitutions),
+// when it is close enough to be a typo (at most a third of the word's length, and at least 1);
+// "" otherwise.
+inline std::string nearest_name(const std::string& word, const std::vector<std::string>& names) {
+  std::string best;
+  size_t best_d = word.size() / 3 + 2;  // one past the largest distance taken
+  for (const std::string& n : names) {
+    std::vector<size_t> row(n.size() + 1);
+    for (size_t j = 0; j <= n.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= word.size(); ++i) {
+      size_t diag = row[0];
+      row[0] = i;
+      for (size_t j = 1; j <= n.size(); ++j) {
+        const size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (word[i - 1] == n[j - 1] ? 0 : 1)});
+        diag = up;
+      }
+    }
+    if (row[n.size()] < best_d) {
+      best_d = row[n.size()];
+      best = n;
+    }
+  }
+  return best;
+}
+
+// `tippe info`'s "can invert" line: whether 1 - alpha < A/C < 1 + alpha, as a true sentence.
+std::string inversion_condition_text(double alpha, double ratio);
+
 Command setup_run(CLI::App& app);
 Command setup_export_mjcf(CLI::App& app);
 Command setup_info(CLI::App& app);

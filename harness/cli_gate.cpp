@@ -38,7 +38,7 @@ struct Group {
 // A report path must be writable as a file; found before anything runs, so that a typo does
 // not cost a whole gate run.
 void check_output(const std::string& path, const char* option) {
-  if (path.empty()) return;
+  if (path.empty() || path == "-") return;
   if (const std::string problem = result_file_problem(path); !problem.empty())
     throw UsageError(std::string(option) + ": " + path + ": " + problem);
 }
@@ -50,7 +50,8 @@ int gate(const GateCliOptions& o) {
   check_output(o.junit, "--junit");
   check_output(o.json, "--json");
   std::error_code ec;
-  if (!o.junit.empty() && !o.json.empty() &&
+  if (o.junit == "-" && o.json == "-") throw UsageError("--junit and --json both name stdout (-)");
+  if (!o.junit.empty() && !o.json.empty() && o.junit != "-" && o.json != "-" &&
       fs::weakly_canonical(fs::absolute(o.junit), ec) == fs::weakly_canonical(fs::absolute(o.json), ec))
     throw UsageError("--junit and --json name the same file " + o.junit);
 
@@ -105,13 +106,20 @@ int gate(const GateCliOptions& o) {
     }
   }
 
-  std::printf("%s", render_table(results).c_str());
-  std::fflush(stdout);
-  if (!o.junit.empty()) write_result_file(o.junit, render_junit(results, o.gates));
+  // With a report on stdout (-), stdout holds that report alone and the table goes to stderr.
+  const bool report_on_stdout = o.junit == "-" || o.json == "-";
+  std::fprintf(report_on_stdout ? stderr : stdout, "%s", render_table(results).c_str());
+  std::fflush(report_on_stdout ? stderr : stdout);
+  auto write = [](const std::string& path, const std::string& text) {
+    if (path != "-") return write_result_file(path, text);
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
+      throw OutputError("stdout: cannot write the report");
+  };
+  if (!o.junit.empty()) write(o.junit, render_junit(results, o.gates));
   if (!o.json.empty()) {
     nlohmann::json j = to_json(results);
     j["gate_file"] = o.gates;
-    write_result_file(o.json, j.dump(2) + "\n");
+    write(o.json, j.dump(2) + "\n");
   }
   return all_passed(results) ? 0 : 1;
 }
@@ -123,8 +131,8 @@ Command setup_gate(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "gate", "Run a gate file's checks (engine settings against metric thresholds); exit 1 when any fails");
   sub->add_option("gates", o->gates, "Gate file (TOML), e.g. harness/gates/default.toml")->required();
-  sub->add_option("--junit", o->junit, "Write a JUnit XML report to FILE");
-  sub->add_option("--json", o->json, "Write the results as JSON to FILE");
+  sub->add_option("--junit", o->junit, "Write a JUnit XML report to FILE (- for stdout)");
+  sub->add_option("--json", o->json, "Write the results as JSON to FILE (- for stdout)");
   sub->add_option("--jobs,-j", o->jobs, "Runs in parallel within a comparison (default: one per core)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--cache", o->cache, "Reference cache directory")->capture_default_str();

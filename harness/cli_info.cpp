@@ -19,6 +19,25 @@ struct InfoOptions {
 
 std::string setting_text(const SettingValue& v) { return setting_to_json(v).dump(); }
 
+}  // namespace
+
+std::string inversion_condition_text(double alpha, double ratio) {
+  char buf[256];
+  // The same test as inversion_possible: 1 - alpha < A/C < 1 + alpha, each side said as it holds.
+  if (1 - alpha < ratio && ratio < 1 + alpha)
+    std::snprintf(buf, sizeof buf, "yes: 1 - alpha = %.6g < A/C = %.6g < 1 + alpha = %.6g", 1 - alpha, ratio,
+                  1 + alpha);
+  else if (ratio >= 1 + alpha)
+    std::snprintf(buf, sizeof buf, "no: A/C = %.6g >= 1 + alpha = %.6g (inversion needs 1 - alpha < A/C < 1 + alpha)",
+                  ratio, 1 + alpha);
+  else
+    std::snprintf(buf, sizeof buf, "no: A/C = %.6g <= 1 - alpha = %.6g (inversion needs 1 - alpha < A/C < 1 + alpha)",
+                  ratio, 1 - alpha);
+  return buf;
+}
+
+namespace {
+
 int info(const InfoOptions& o) {
   const Scene s = load_scene(o.scene, o.sets);
   const MassProperties& m = s.mass;
@@ -38,8 +57,7 @@ int info(const InfoOptions& o) {
   std::printf("inertia A, C       %.10g, %.10g\n", m.inertia_transverse, m.inertia_axial);
   std::printf("alpha = d/R        %.10g\n", alpha);
   std::printf("A/C                %.10g\n", ratio);
-  std::printf("can invert         %s (1 - alpha = %.6g < A/C = %.6g < 1 + alpha = %.6g)\n",
-              inversion_possible(m, R) ? "yes" : "no", 1 - alpha, ratio, 1 + alpha);
+  std::printf("can invert         %s\n", inversion_condition_text(alpha, ratio).c_str());
   std::printf("contact            %s, mu = %g, k = %g, drilling = %g, flight %s\n", to_string(s.contact.friction),
               s.contact.mu, s.contact.k, s.contact.drilling, s.contact.flight ? "on" : "off");
   std::printf("run                duration %g, sample interval %g, rtol %g, atol %g\n", s.run.duration,

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "cli.h"
+#include "progress.h"
 #include "records.h"
 #include "scene_io.h"
 
@@ -22,15 +23,19 @@ struct RunOptions {
   std::vector<std::string> sets;
 };
 
-// "\r[engine] t = 1.234 / 8.000 (15%)" on stderr, at most ten times a second.
+// "[engine] t = 1.234 / 8.000 (15%)" on stderr: on a terminal redrawn at most ten times a
+// second, in a log one line every kProgressLineSeconds and the last, with --quiet nothing.
 class ProgressLine {
  public:
-  explicit ProgressLine(std::string engine) : engine_(std::move(engine)) {}
+  explicit ProgressLine(std::string engine) : engine_(std::move(engine)), mode_(progress_mode()) {}
   void update(double t, double duration) {
     t_ = t;
     duration_ = duration;
+    if (mode_ == ProgressMode::Quiet) return;
     const auto now = std::chrono::steady_clock::now();
-    if (shown_ && now - last_ < std::chrono::milliseconds(100)) return;
+    const auto gap = mode_ == ProgressMode::Redraw ? std::chrono::duration<double>(0.1)
+                                                   : std::chrono::duration<double>(kProgressLineSeconds);
+    if (shown_ && now - last_ < gap) return;
     shown_ = true;
     last_ = now;
     print();
@@ -38,21 +43,23 @@ class ProgressLine {
   void finish() {
     if (!shown_) return;
     print();
-    std::fputc('\n', stderr);
+    if (mode_ == ProgressMode::Redraw) std::fputc('\n', stderr);
     shown_ = false;
   }
   ~ProgressLine() {
     // Ends the line so that an error message does not land after the carriage return.
-    if (shown_) std::fputc('\n', stderr);
+    if (shown_ && mode_ == ProgressMode::Redraw) std::fputc('\n', stderr);
   }
 
  private:
   void print() const {
     const int pct = duration_ > 0 ? static_cast<int>(100.0 * t_ / duration_) : 100;
-    std::fprintf(stderr, "\r[%s] t = %.3f / %.3f (%d%%)", engine_.c_str(), t_, duration_, pct);
+    std::fprintf(stderr, mode_ == ProgressMode::Redraw ? "\r[%s] t = %.3f / %.3f (%d%%)" : "[%s] t = %.3f / %.3f (%d%%)\n",
+                 engine_.c_str(), t_, duration_, pct);
     std::fflush(stderr);
   }
   std::string engine_;
+  ProgressMode mode_;
   double t_ = 0, duration_ = 0;
   bool shown_ = false;
   std::chrono::steady_clock::time_point last_;

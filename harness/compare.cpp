@@ -1,5 +1,6 @@
 // Side-by-side runs of the reference and engines on one scene, the metrics that compare them, and their records.
 #include "compare.h"
+#include "progress.h"
 
 #include <algorithm>
 #include <array>
@@ -673,7 +674,17 @@ class ProgressBoard {
     why_[i] = status;
     state_[i].store(Stopped);
   }
-  void print() {
+  // final_line: the last state, ended with a newline. In Lines mode (not a terminal) a line at
+  // most every kProgressLineSeconds, and the last; Quiet: nothing.
+  void print(bool final_line = false) {
+    const ProgressMode mode = progress_mode();
+    if (mode == ProgressMode::Quiet) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (mode == ProgressMode::Lines && !final_line && printed_ &&
+        std::chrono::duration<double>(now - last_).count() < kProgressLineSeconds)
+      return;
+    printed_ = true;
+    last_ = now;
     std::string line = "[compare " + scene_ + "]";
     for (size_t i = 0; i < names_.size(); ++i) {
       line += i ? " | " : " ";
@@ -690,15 +701,23 @@ class ProgressBoard {
           break;
       }
     }
+    if (mode == ProgressMode::Lines) {
+      std::fprintf(stderr, "%s\n", line.c_str());
+      std::fflush(stderr);
+      return;
+    }
     // Pads over the tail of a longer previous line.
     const size_t len = line.size();
     if (line.size() < width_) line.append(width_ - line.size(), ' ');
     width_ = len;
     std::fprintf(stderr, "\r%s", line.c_str());
+    if (final_line) std::fputc('\n', stderr);
     std::fflush(stderr);
   }
 
  private:
+  bool printed_ = false;
+  std::chrono::steady_clock::time_point last_;
   std::string scene_;
   std::vector<std::string> names_;
   double duration_;
@@ -974,10 +993,7 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
         run_task(t, t.scene ? *t.scene : scene, board, todo[k]);
       },
       redraw);
-  if (options.progress) {
-    board.print();
-    std::fputc('\n', stderr);
-  }
+  if (options.progress) board.print(true);
 
   for (const Task& t : tasks)
     if (t.fatal) std::rethrow_exception(t.fatal);

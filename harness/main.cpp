@@ -1,14 +1,23 @@
 // The `tippe` command line: parses the arguments and runs one subcommand (each lives in a cli_*.cpp).
+#include <algorithm>
 #include <iostream>
 #include <map>
+#include <string>
+#include <vector>
 
 #include "cli.h"
+#include "progress.h"
 #include "scene_io.h"
 
 int main(int argc, char** argv) {
   using namespace tippe;
   CLI::App app{"tippe: the tippe-top verification bench"};
   app.require_subcommand(1);
+  // Every subcommand takes --quiet, also after its own options: subcommands made after
+  // fallthrough() hand an option they do not know up to here.
+  bool quiet = false;
+  app.add_flag("-q,--quiet", quiet, "No progress on stderr (errors and warnings still go there)");
+  app.fallthrough();
   // Adding a subcommand: write cli_NAME.cpp with setup_NAME, declare it in cli.h, list it here.
   const cli::Setup commands[] = {cli::setup_run, cli::setup_export_mjcf, cli::setup_info,
                                   cli::setup_compare, cli::setup_report, cli::setup_sweep,
@@ -17,6 +26,23 @@ int main(int argc, char** argv) {
   for (cli::Setup setup : commands) {
     cli::Command c = setup(app);
     actions[c.sub] = std::move(c.action);
+  }
+
+  // A word where a subcommand belongs that is none: say so, with the nearest name, instead of
+  // CLI11's "arguments were not expected".
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string word = argv[1];
+    std::vector<std::string> names;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) names.push_back(sub->get_name());
+    if (std::find(names.begin(), names.end(), word) == names.end()) {
+      std::cerr << "tippe: error: unknown subcommand '" << word << "'";
+      const std::string near = cli::nearest_name(word, names);
+      if (!near.empty()) std::cerr << " (did you mean '" << near << "'?)";
+      std::cerr << "; the subcommands are:";
+      for (const std::string& n : names) std::cerr << " " << n;
+      std::cerr << "\n(run with --help for usage)\n";
+      return 2;
+    }
   }
 
   try {
@@ -30,6 +56,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  set_progress_mode(progress_mode_for_stderr(quiet));
   install_interrupt_handlers();
   try {
     const int code = actions.at(app.get_subcommands().front())();

@@ -1,5 +1,6 @@
 // Work-precision sweeps: reading sweep files into checked plans, the records.jsonl format, and resumable parallel runs.
 #include "sweep.h"
+#include "progress.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -1158,7 +1159,7 @@ class SweepProgress {
   void print(bool final_line) {
     std::lock_guard<std::mutex> lock(m_);
     const double elapsed = now() - start_;
-    if (lines_ && !final_line && elapsed - last_line_ < 10.0) return;
+    if (lines_ && !final_line && elapsed - last_line_ < kProgressLineSeconds) return;
     last_line_ = elapsed;
     char buf[160];
     std::snprintf(buf, sizeof buf, "[sweep] %zu/%zu points", done_ + skipped_, total_);
@@ -1640,10 +1641,11 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
     if (farm.coordinator()) {
       appender = std::make_unique<RecordAppender>(records_file);
       progress = std::make_unique<SweepProgress>(plan, prep.todo, prep.share, prep.skipped, farm.workers(),
-                                                 farm.distributed());
+                                                 farm.distributed() || progress_mode() == ProgressMode::Lines);
     }
+    const bool show = o.progress && progress_mode() != ProgressMode::Quiet;
     TaskFarm::Idle idle;
-    if (o.progress && farm.coordinator()) idle = [&] { progress->print(false); };
+    if (show && farm.coordinator()) idle = [&] { progress->print(false); };
     farm.run(
         prep.todo.size(),
         [&](size_t k) {
@@ -1660,7 +1662,7 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
           progress->begin(prep.todo[k]);
         },
         idle);
-    if (o.progress && farm.coordinator()) progress->print(true);
+    if (show && farm.coordinator()) progress->print(true);
   }
   outcome.ran = prep.todo.size();
   outcome.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

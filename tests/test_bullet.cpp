@@ -167,7 +167,7 @@ TEST(Bullet, SettingsErrorsNameTheKey) {
   good.engines["bullet"]["gyroscopic"] = std::string("implicit_world");
   EXPECT_NO_THROW(validate_bullet_settings(good));
   const auto sim = make_simulator("bullet", good);
-  EXPECT_EQ(setting(*sim, "timestep"), "0.00020000000000000001");
+  EXPECT_EQ(setting(*sim, "timestep"), "0.0002");
   EXPECT_EQ(setting(*sim, "substeps"), "2");
   EXPECT_EQ(setting(*sim, "internal_step"), "0.0001");
   EXPECT_EQ(bullet_readback(*sim).gyroscopic, "implicit_world");

@@ -194,13 +194,13 @@ TEST(Mujoco, SettingsAreListedAndApplied) {
   EXPECT_NO_THROW(validate_mujoco_settings(s));
   const auto sim = make_mujoco_simulator(s);
   const SettingsList list = sim->settings();
-  EXPECT_EQ(setting_value(list, "timestep"), "0.00020000000000000001");
+  EXPECT_EQ(setting_value(list, "timestep"), "0.0002");
   EXPECT_EQ(setting_value(list, "integrator"), "Euler");
   EXPECT_EQ(setting_value(list, "iterations"), "30");
   EXPECT_EQ(setting_value(list, "cone"), "elliptic");
   EXPECT_EQ(setting_value(list, "solref"), "[0.002, 1]");
   EXPECT_EQ(setting_value(list, "condim_used"), "3");
-  EXPECT_EQ(setting_value(list, "friction_used"), "[0.29999999999999999, 0, 0]");
+  EXPECT_EQ(setting_value(list, "friction_used"), "[0.3, 0, 0]");
   EXPECT_EQ(sim->version(), "mujoco 2.2.2");
   EXPECT_EQ(mujoco_model_readback(*sim).timestep, 2e-4);
   sim->advance_to(0.01);
@@ -389,7 +389,7 @@ TEST(Mujoco, SolrefBelowTwoStepsIsRaisedAsMujocoDoes) {
   s.engines["mujoco"]["solref"] = std::vector<double>{1e-4, 1.0};
   const auto sim = make_mujoco_simulator(s);
   EXPECT_EQ(setting_value(sim->settings(), "solref"), "[0.0001, 1]");
-  EXPECT_EQ(setting_value(sim->settings(), "solref_used"), "[0.00020000000000000001, 1]");
+  EXPECT_EQ(setting_value(sim->settings(), "solref_used"), "[0.0002, 1]");
   bool noted = false;
   for (const auto& n : sim->notes()) noted = noted || n.find("raised by MuJoCo") != std::string::npos;
   EXPECT_TRUE(noted);

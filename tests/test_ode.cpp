@@ -169,7 +169,7 @@ TEST(Ode, SettingsAreListedAndApplied) {
       if (kv.first == key) return kv.second;
     return std::string("<missing>");
   };
-  EXPECT_EQ(value("timestep"), "0.00020000000000000001");
+  EXPECT_EQ(value("timestep"), "0.0002");
   EXPECT_EQ(value("stepper"), "quickstep");
   EXPECT_EQ(value("iterations"), "30");
   EXPECT_EQ(value("friction_model"), "approx1");
