@@ -161,17 +161,27 @@ TEST(Bullet, SettingsErrorsNameTheKey) {
   Scene bad_directions = dimensionless_scene();
   bad_directions.engines["bullet"]["friction_directions"] = 3LL;
   expect_setting_error(bad_directions, "friction_directions");
+  Scene bad_unit = dimensionless_scene();
+  bad_unit.engines["bullet"]["mass_unit"] = 0.0;
+  expect_setting_error(bad_unit, "mass_unit");
 
   Scene good = dimensionless_scene();
   good.engines["bullet"]["timestep"] = 2e-4;
   good.engines["bullet"]["substeps"] = 2LL;
   good.engines["bullet"]["gyroscopic"] = std::string("implicit_world");
+  good.engines["bullet"]["mass_unit"] = 1e-3;
   EXPECT_NO_THROW(validate_bullet_settings(good));
   const auto sim = make_simulator("bullet", good);
   EXPECT_EQ(setting(*sim, "timestep"), "0.00020000000000000001");
   EXPECT_EQ(setting(*sim, "substeps"), "2");
   EXPECT_EQ(setting(*sim, "internal_step"), "0.0001");
-  EXPECT_EQ(bullet_readback(*sim).gyroscopic, "implicit_world");
+  EXPECT_EQ(setting(*sim, "mass_unit"), "0.001");
+  const BulletReadback r = bullet_readback(*sim);
+  EXPECT_EQ(r.gyroscopic, "implicit_world");
+  // Read back in the scene's units: Bullet holds M / mass_unit (rounding of two divisions).
+  EXPECT_NEAR(r.mass, 1.0, 1e-15);
+  EXPECT_NEAR(r.inertia_B.x(), 0.4, 1e-15);
+  EXPECT_NEAR(r.inertia_B.z(), 0.45, 1e-15);
 }
 
 // An upright top (tilt 0) on a frictionless floor: the floor's force is vertical through the
