@@ -22,6 +22,8 @@ struct BulletSettings {
   // vanishes (the SI toy top: 1.2e-18 kg^3 m^6; every SI top of the bench but mujoco_tutorial).
   // 1 = the scene's units, what a Bullet user passes, so the default is Bullet's answer in those
   // units; a run in which the term vanished says so in a note. 1e-3 (grams) moves det by 1e9.
+  // Impulses grow by 1/mass_unit in Bullet: its spinning-friction cap (a normal impulse of 1 per
+  // internal step) comes closer, and a run that reaches it ends as clamped.
   double mass_unit = 1.0;
   // PGS sweeps per internal step. One point contact converges in a few; the ball+stem phase
   // couples the rows: on the viscous source scene at t = 25, Bullet's default 10 differs from
