@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "adapters.h"
+#include "bullet_settings.h"
 #include "fixed_step.h"
 #include "settings.h"
 
@@ -42,89 +43,6 @@ constexpr double kRollingGateOverR = 1e-12;
 
 // A manifold point within this gap (relative to R) counts as touching even without impulse.
 constexpr double kTouchGapOverR = 1e-6;
-
-// Every setting of the Bullet model that decides accuracy, read from [engines.bullet].
-struct BulletSettings {
-  // Scene step. Bullet's step is first order (one PGS solve, semi-implicit Euler); 1e-4 keeps
-  // |omega| h at 0.015 for a 150 rad/s top, far below the pi/4 rotation clamp, and the energy
-  // drift small (frictionless tilted dimensionless top: |E - E0| = 4e-7 after 30 units, 4e-6 at 1e-3).
-  double timestep = 1e-4;
-  // Internal fixed steps per scene step (each a full collide-solve-integrate); 1 = none needed at 1e-4.
-  int substeps = 1;
-  // PGS sweeps per internal step. One point contact converges in a few; the ball+stem phase
-  // couples the rows: on the viscous source scene at t = 25, Bullet's default 10 differs from
-  // 200 by 4e-4 in the spin, 50 agrees with 200 to 6 digits.
-  int solver_iterations = 50;
-  // m_erp: in 3.24 used by joints only (there are none here; contacts use erp2). Bullet's default.
-  double erp = 0.2;
-  // m_erp2: fraction of a contact's penetration removed per internal step, by the split-impulse
-  // push or (split off) by Baumgarte velocity. Bullet's default.
-  double erp2 = 0.2;
-  // m_globalCfm: 0 = hard contact (Bullet's default); > 0 softens the contact.
-  double cfm = 0.0;
-  // true: penetration is removed by a separate push that leaves no momentum behind. With
-  // Baumgarte (false) the correction velocity stays in the body, i.e. penetration turns into
-  // kinetic energy (measured: 1 % R depth gives v_z = 2 at h = 1e-3) — wrong for an energy
-  // budget over 30 time units.
-  bool split_impulse = true;
-  // Penetration depth (scene length, <= 0) beyond which the split push is used; shallower
-  // contacts get Baumgarte. Bullet's default -0.04 (metres) would leave every contact of this
-  // bench on Baumgarte; 0 sends all penetration to the push and needs no length scale.
-  double split_impulse_threshold = 0.0;
-  // Fraction of the split push's angular part applied (Bullet's default).
-  double split_impulse_turn_erp = 0.1;
-  // Start each solve from the last step's impulses times the factor (Bullet's defaults).
-  bool warmstarting = true;
-  double warmstarting_factor = 0.85;
-  // PGS over-relaxation (Bullet's default 1: plain Gauss-Seidel).
-  double sor = 1.0;
-  // The w x I w term. implicit_body: one Newton step of the implicit Euler equations in the
-  // body frame, the accurate and stable one for a fast top (Bullet's default); explicit is
-  // forward Euler on w x I w, which gains energy at large |omega| h; none is not the top's
-  // physics (diagnostic only: the viscous source top then inverts at 12.4 instead of 17.25).
-  std::string gyroscopic = "implicit_body";
-  // Friction rows per contact point: 2 (SOLVER_USE_2_FRICTION_DIRECTIONS, each bounded by
-  // mu P_n: a box) or 1 (along the slip velocity only).
-  int friction_directions = 2;
-  // First friction direction along the slip velocity (Bullet's default) or a fixed tangent basis
-  // (SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION).
-  bool velocity_friction_direction = true;
-  // Friction coefficient that stands in for the rolling constraint (friction = rolling).
-  double rolling_mu = 1e3;
-  // The stem's collision shape: a capsule from O to P (what a user models as the stem), or the
-  // sphere of radius r at P alone (the reference's stem contact). Their lowest points agree at
-  // every tilt (the capsule's other end lies inside the ball); Bullet's support-point routines
-  // differ, hence a choice to sweep.
-  std::string stem_shape = "capsule";
-  // Bullet's contact breaking threshold relative to the body's size: a manifold point is kept
-  // (and matched to the next step's point, carrying its warm-start impulse) while it stays within
-  // this fraction of the compound's angular motion disc (~ its bounding radius). Bullet's default
-  // is gContactBreakingThreshold = 0.02 with CD_USE_RELATIVE_CONTACT_BREAKING_THRESHOLD, i.e.
-  // 0.02 x the disc: the value here. A length-scale choice of the engine, not physics.
-  double contact_breaking_threshold = 0.02;
-
-  template <class V>
-  void visit(V& v) {
-    v("timestep", timestep, 1e-8, 1.0);
-    v("substeps", substeps, 1, 100000);
-    v("solver_iterations", solver_iterations, 1, 1000000);
-    v("erp", erp, 0.0, 1.0);
-    v("erp2", erp2, 0.0, 1.0);
-    v("cfm", cfm, 0.0, 1.0);
-    v("split_impulse", split_impulse);
-    v("split_impulse_threshold", split_impulse_threshold, -1e6, 0.0);
-    v("split_impulse_turn_erp", split_impulse_turn_erp, 0.0, 1.0);
-    v("warmstarting", warmstarting);
-    v("warmstarting_factor", warmstarting_factor, 0.0, 1.0);
-    v("sor", sor, 0.0, 2.0);
-    v("gyroscopic", gyroscopic, {"none", "explicit", "implicit_world", "implicit_body"});
-    v("friction_directions", friction_directions, 1, 2);
-    v("velocity_friction_direction", velocity_friction_direction);
-    v("rolling_mu", rolling_mu, 0.0, 1e15);
-    v("stem_shape", stem_shape, {"capsule", "tip_sphere"});
-    v("contact_breaking_threshold", contact_breaking_threshold, 0.0, 1.0);
-  }
-};
 
 btVector3 to_bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
 Vec3 to_eigen(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
@@ -213,7 +131,7 @@ struct ContactSum {
   double impulse = 0.0;
   double impulse_ball = 0.0, impulse_stem = 0.0;  // the parts of impulse on each geom
   Vec3 moment = Vec3::Zero();
-  double max_point_impulse = 0.0;
+  double max_point_impulse = 0.0;  // in Bullet's units (its spinning-friction cap is there)
 };
 
 }  // namespace
@@ -229,7 +147,7 @@ class BulletSimulator : public FixedStepSimulator {
     return "bullet " + std::to_string(BT_BULLET_VERSION / 100) + "." + std::to_string(BT_BULLET_VERSION % 100);
   }
   SettingsList settings() const override;
-  std::vector<std::string> notes() const override { return notes_; }
+  std::vector<std::string> notes() const override;
 
   BulletReadback readback() const;
 
@@ -254,6 +172,7 @@ class BulletSimulator : public FixedStepSimulator {
   void collect_contacts(ContactSum& sum) const;
   bool is_stem_point(const btManifoldPoint& cp, bool body_is_0) const;
   void check_rotation(const char* when);
+  bool gyroscopic_dropped() const;
 
   BulletSettings settings_;
   double h_ = 0.0;  // internal step
@@ -264,6 +183,9 @@ class BulletSimulator : public FixedStepSimulator {
   ContactReport report_;
   std::string limit_;
   long long solver_iterations_ = 0;
+  long long internal_steps_ = 0;
+  long long gyro_dropped_steps_ = 0;  // internal steps in which solve33 dropped w x I w
+  double gyro_dropped_first_ = -1.0;  // time of the first such step
 };
 
 BulletSimulator::BulletSimulator(const Scene& scene)
@@ -337,8 +259,8 @@ BulletSimulator::BulletSimulator(const Scene& scene)
   {
     // The body frame is the principal frame at G, so the inertia is the scene's diagonal; never
     // calculateLocalInertia (a box approximation for capsules and compounds).
-    const btVector3 I_B(m.A, m.A, m.C);
-    btRigidBody::btRigidBodyConstructionInfo info(m.M, nullptr, o_.body_shape.get(), I_B);
+    const btVector3 I_B = btVector3(m.A, m.A, m.C) / settings_.mass_unit;
+    btRigidBody::btRigidBodyConstructionInfo info(m.M / settings_.mass_unit, nullptr, o_.body_shape.get(), I_B);
     info.m_startWorldTransform = start_W;
     info.m_linearDamping = 0;
     info.m_angularDamping = 0;
@@ -352,7 +274,7 @@ BulletSimulator::BulletSimulator(const Scene& scene)
     o_.body = std::make_unique<btRigidBody>(info);
   }
   btRigidBody* b = o_.body.get();
-  b->setMassProps(m.M, btVector3(m.A, m.A, m.C));
+  b->setMassProps(m.M / settings_.mass_unit, btVector3(m.A, m.A, m.C) / settings_.mass_unit);
   b->updateInertiaTensor();
   b->setDamping(0, 0);
   b->setActivationState(DISABLE_DEACTIVATION);
@@ -464,6 +386,40 @@ void BulletSimulator::check_rotation(const char* when) {
   }
 }
 
+// Whether Bullet's gyroscopic step about to be taken drops w x I w: the determinant of the
+// Newton matrix exactly as btRigidBody::computeGyroscopicImpulseImplicit_Body builds it (the
+// world variant's matrix is its rotation, the same determinant), against solve33's guard.
+bool BulletSimulator::gyroscopic_dropped() const {
+  const btRigidBody* b = o_.body.get();
+  const int f = b->getFlags();
+  if (!(f & (BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY | BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_WORLD))) return false;
+  const btVector3 idl = b->getLocalInertia();
+  const btVector3 w_B = quatRotate(b->getWorldTransform().getRotation().inverse(), b->getAngularVelocity());
+  btMatrix3x3 Ib;
+  Ib.setValue(idl.x(), 0, 0, 0, idl.y(), 0, 0, 0, idl.z());
+  btMatrix3x3 skew0, skew1;
+  w_B.getSkewSymmetricMatrix(&skew0[0], &skew0[1], &skew0[2]);
+  (Ib * w_B).getSkewSymmetricMatrix(&skew1[0], &skew1[1], &skew1[2]);
+  const btMatrix3x3 J = Ib + (skew0 * Ib - skew1) * h_;
+  const double det = btDot(J.getColumn(0), btCross(J.getColumn(1), J.getColumn(2)));
+  return !(std::abs(det) > SIMD_EPSILON);
+}
+
+std::vector<std::string> BulletSimulator::notes() const {
+  std::vector<std::string> n = notes_;
+  if (gyro_dropped_steps_ > 0) {
+    const btVector3 I = o_.body->getLocalInertia();
+    std::ostringstream os;
+    os.precision(3);
+    os << "gyroscopic term w x I w dropped by Bullet in " << gyro_dropped_steps_ << " of " << internal_steps_
+       << " internal steps (from t = " << gyro_dropped_first_ << "): its implicit step's 3x3 solve (btMatrix3x3::solve33) "
+       << "inverts the determinant only above SIMD_EPSILON = " << SIMD_EPSILON << ", and A^2 C = " << I.x() * I.y() * I.z()
+       << " in Bullet's units; a smaller engines.bullet.mass_unit avoids it (the determinant goes as mass_unit^-3)";
+    n.push_back(os.str());
+  }
+  return n;
+}
+
 void BulletSimulator::engine_step() {
   btRigidBody* b = o_.body.get();
   ContactSum sum;
@@ -471,7 +427,14 @@ void BulletSimulator::engine_step() {
     check_rotation("before");
     // stepSimulation clears the force accumulators after every call (checked by the tests):
     // the bench's force is re-applied for each internal step so that it acts over the whole dt.
-    for (const PendingForce& f : pending_) b->applyForce(to_bt(f.f_W), to_bt(f.r_W));
+    for (const PendingForce& f : pending_) b->applyForce(to_bt(f.f_W / settings_.mass_unit), to_bt(f.r_W));
+    // Bullet computes its gyroscopic step from this velocity and attitude (stepSimulation changes
+    // neither before the solve).
+    ++internal_steps_;
+    if (gyroscopic_dropped()) {
+      if (gyro_dropped_steps_ == 0) gyro_dropped_first_ = time() + k * h_;
+      ++gyro_dropped_steps_;
+    }
     // maxSubSteps = 0 is Bullet's variable-step mode: exactly one internal step of h_, no
     // accumulator of leftover time and no interpolated transforms.
     o_.world->stepSimulation(h_, 0, h_);
@@ -500,7 +463,7 @@ void BulletSimulator::engine_step() {
   // normal impulse in one internal step exceeds 1.
   if (limit_.empty() && spinning_ > 0 && sum.max_point_impulse > 1.0)
     limit_ = "Bullet spinning-friction cap: normal impulse " + num(sum.max_point_impulse) +
-             " > 1 in one internal step bounds the drilling torque by mu_d instead of mu_d P_n";
+             " > 1 (Bullet's mass unit) in one internal step bounds the drilling torque by mu_d instead of mu_d P_n";
 }
 
 bool BulletSimulator::is_stem_point(const btManifoldPoint& cp, bool body_is_0) const {
@@ -530,7 +493,8 @@ void BulletSimulator::collect_contacts(ContactSum& sum) const {
     if (!body_is_0 && m->getBody1() != b) continue;
     for (int j = 0; j < m->getNumContacts(); ++j) {
       const btManifoldPoint& cp = m->getContactPoint(j);
-      const double P = cp.getAppliedImpulse();
+      const double P_bt = cp.getAppliedImpulse();  // Bullet's mass unit
+      const double P = P_bt * settings_.mass_unit;
       if (!(cp.getDistance() <= touch_gap || P > 0)) continue;
       const bool stem = is_stem_point(cp, body_is_0);
       (stem ? sum.stem : sum.ball) = true;
@@ -540,7 +504,7 @@ void BulletSimulator::collect_contacts(ContactSum& sum) const {
         const btVector3& p_W = body_is_0 ? cp.getPositionWorldOnB() : cp.getPositionWorldOnA();
         sum.impulse += P;
         sum.moment += P * to_eigen(p_W);
-        sum.max_point_impulse = std::max(sum.max_point_impulse, P);
+        sum.max_point_impulse = std::max(sum.max_point_impulse, P_bt);
       }
     }
   }
@@ -567,9 +531,11 @@ void BulletSimulator::apply_force_W(const Vec3& f_W, const Vec3& p_W) {
 BulletReadback BulletSimulator::readback() const {
   const btRigidBody* b = o_.body.get();
   BulletReadback r;
-  r.mass = 1.0 / b->getInvMass();
-  r.inertia_B = to_eigen(b->getLocalInertia());
-  r.inv_inertia_B = to_eigen(b->getInvInertiaDiagLocal());
+  // In the scene's units (Bullet holds them divided by mass_unit).
+  const double mu = settings_.mass_unit;
+  r.mass = mu / b->getInvMass();
+  r.inertia_B = to_eigen(b->getLocalInertia()) * mu;
+  r.inv_inertia_B = to_eigen(b->getInvInertiaDiagLocal()) / mu;
   const btTransform& T_WB = b->getCenterOfMassTransform();
   r.p_WG = to_eigen(T_WB.getOrigin());
   btQuaternion q;
@@ -608,8 +574,8 @@ BulletReadback BulletSimulator::readback() const {
                  : (f & BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_WORLD) ? "implicit_world"
                  : (f & BT_ENABLE_GYROSCOPIC_FORCE_EXPLICIT)       ? "explicit"
                                                                    : "none";
-  r.total_force_W = to_eigen(b->getTotalForce());
-  r.total_torque_W = to_eigen(b->getTotalTorque());
+  r.total_force_W = to_eigen(b->getTotalForce()) * mu;
+  r.total_torque_W = to_eigen(b->getTotalTorque()) * mu;
   btDispatcher* d = o_.dispatcher.get();
   for (int i = 0; i < d->getNumManifolds(); ++i) {
     const btPersistentManifold* m = d->getManifoldByIndexInternal(i);

@@ -12,6 +12,7 @@
 #include "bullet_sim.h"
 #include "initial_state.h"
 #include "observables.h"
+#include "scene_io.h"
 #include "simulator.h"
 
 namespace tippe {
@@ -160,17 +161,27 @@ TEST(Bullet, SettingsErrorsNameTheKey) {
   Scene bad_directions = dimensionless_scene();
   bad_directions.engines["bullet"]["friction_directions"] = 3LL;
   expect_setting_error(bad_directions, "friction_directions");
+  Scene bad_unit = dimensionless_scene();
+  bad_unit.engines["bullet"]["mass_unit"] = 0.0;
+  expect_setting_error(bad_unit, "mass_unit");
 
   Scene good = dimensionless_scene();
   good.engines["bullet"]["timestep"] = 2e-4;
   good.engines["bullet"]["substeps"] = 2LL;
   good.engines["bullet"]["gyroscopic"] = std::string("implicit_world");
+  good.engines["bullet"]["mass_unit"] = 1e-3;
   EXPECT_NO_THROW(validate_bullet_settings(good));
   const auto sim = make_simulator("bullet", good);
   EXPECT_EQ(setting(*sim, "timestep"), "0.0002");
   EXPECT_EQ(setting(*sim, "substeps"), "2");
   EXPECT_EQ(setting(*sim, "internal_step"), "0.0001");
-  EXPECT_EQ(bullet_readback(*sim).gyroscopic, "implicit_world");
+  EXPECT_EQ(setting(*sim, "mass_unit"), "0.001");
+  const BulletReadback r = bullet_readback(*sim);
+  EXPECT_EQ(r.gyroscopic, "implicit_world");
+  // Read back in the scene's units: Bullet holds M / mass_unit (rounding of two divisions).
+  EXPECT_NEAR(r.mass, 1.0, 1e-15);
+  EXPECT_NEAR(r.inertia_B.x(), 0.4, 1e-15);
+  EXPECT_NEAR(r.inertia_B.z(), 0.45, 1e-15);
 }
 
 // An upright top (tilt 0) on a frictionless floor: the floor's force is vertical through the
@@ -309,6 +320,98 @@ TEST(Bullet, TwoThreadsAtOnceMatchSerial) {
   tb.join();
   EXPECT_TRUE(same_bits(a, serial->observe()));
   EXPECT_TRUE(same_bits(b, serial->observe()));
+}
+
+// The SI toy top (A^2 C = 1.2e-18 kg^3 m^6) thrown 1 m above the floor, spinning about a tilted
+// axis: torque-free about G until it lands (after 0.45 s), so Euler's equations hold exactly.
+Scene si_toy_in_flight(double mass_unit, const std::string& gyroscopic) {
+  Scene s = load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/toy_viscous.toml");
+  s.contact.friction = FrictionLaw::None;
+  s.contact.flight = true;
+  s.initial.height = 1.0;
+  s.initial.omega_given = true;
+  s.initial.omega_B = {5.0, 0.0, 150.0};
+  s.engines["bullet"]["mass_unit"] = mass_unit;
+  s.engines["bullet"]["gyroscopic"] = gyroscopic;
+  return s;
+}
+
+bool has_note_containing(const Simulator& sim, const std::string& text) {
+  for (const std::string& n : sim.notes())
+    if (n.find(text) != std::string::npos) return true;
+  return false;
+}
+
+// Bullet's implicit gyroscopic step (its default) solves a 3x3 system with btMatrix3x3::solve33,
+// which inverts the determinant only above SIMD_EPSILON = 2.2e-16: for the SI toy top the
+// determinant is ~A^2 C = 1.2e-18 kg^3 m^6, so w x I w vanishes and the run is the one without
+// the gyroscopic term (to rounding). That is Bullet's behaviour in SI units (kept, with a note);
+// mass_unit = 1e-3 (grams) gives Bullet det ~ 1.2e-9 and the term back.
+TEST(Bullet, GyroscopicTermVanishesBelowSolve33GuardAndMassUnitRestoresIt) {
+  const double T = 0.2;
+  auto run = [T](double mass_unit, const std::string& gyroscopic) {
+    auto sim = make_simulator("bullet", si_toy_in_flight(mass_unit, gyroscopic));
+    sim->advance_to(T);
+    EXPECT_EQ(sim->status(), RunStatus::Ok) << sim->status_detail();
+    return sim;
+  };
+  const auto si = run(1.0, "implicit_body");
+  const auto si_none = run(1.0, "none");
+  const auto grams = run(1e-3, "implicit_body");
+  // Not bit for bit: Bullet still adds R (R^T w - 0) - w, rounding of the frame round trip.
+  const BodyState a = si->observe().state, b = si_none->observe().state;
+  std::cout << "SI implicit_body - none after " << T << " s: |dw| " << (a.w_B - b.w_B).norm() << ", |dp| "
+            << (a.p_WG - b.p_WG).norm() << "\n";
+  // Measured 1e-13 of |w| = 150 rad/s; 1e-10 is rounding's bound over 2000 steps, far below the
+  // gyroscopic term's effect (the phase below turns by 0.9 rad).
+  EXPECT_LE((a.w_B - b.w_B).norm(), 1e-10 * 150.0);
+  EXPECT_TRUE(has_note_containing(*si, "gyroscopic term w x I w dropped"));
+  EXPECT_FALSE(has_note_containing(*grams, "gyroscopic term w x I w dropped"));
+  EXPECT_FALSE(has_note_containing(*si_none, "gyroscopic term w x I w dropped"));  // nothing to drop
+
+  // Euler's equations of the free symmetric top: w_3 stays, (w_1, w_2) turns in the body at
+  // -(A - C) w_3 / A = -4.58 rad/s, i.e. by -0.915 rad in 0.2 s. Without w x I w the body turns
+  // about a fixed w_W, so w_B does not turn at all.
+  const BodyModel m = BodyModel::from_scene(si_toy_in_flight(1.0, "none"));
+  const double want = -(m.A - m.C) / m.A * 150.0 * T;
+  auto phase = [](const Simulator& sim) {
+    const Vec3 w = sim.observe().state.w_B;
+    return std::atan2(w.y(), w.x());
+  };
+  std::cout.precision(10);
+  std::cout << "w_B phase after " << T << " s: exact " << want << ", grams " << phase(*grams) << ", SI " << phase(*si) << "\n";
+  // Bullet's one Newton step of implicit Euler per step has a phase error below lambda^2 h T =
+  // 4e-4 rad (measured 6e-8); 1e-3 rad is a tenth of a percent of the turn.
+  EXPECT_NEAR(phase(*grams), want, 1e-3);
+  EXPECT_NEAR(phase(*si), 0.0, 1e-3);
+}
+
+// mass_unit is a unit and nothing else: Bullet's answer for the same top must not move with it
+// once the gyroscopic guard is out of reach, nor between the SI top and the same top in a unit
+// of length of 15 mm (every dimensionless number the same), which is the scaled scene.
+TEST(Bullet, MassUnitAndLengthUnitLeaveTheAnswerAlone) {
+  auto inversion = [](const std::string& file, double mass_unit) {
+    Scene s = load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/" + file);
+    s.engines["bullet"]["mass_unit"] = mass_unit;
+    auto sim = make_simulator("bullet", s);
+    sim->advance_to(s.run.duration);
+    EXPECT_EQ(sim->status(), RunStatus::Ok) << sim->status_detail();
+    for (const Event& e : sim->events())
+      if (e.name == "inversion") return e.time;
+    ADD_FAILURE() << file << " at mass_unit " << mass_unit << " did not invert";
+    return -1.0;
+  };
+  const double grams = inversion("toy_viscous.toml", 1e-3);
+  const double milligrams = inversion("toy_viscous.toml", 1e-6);
+  const double unit_length = inversion("scaled/toy_viscous_unit_length.toml", 1.0);
+  // The runs differ by rounding only (the same numbers times powers of ten): measured equal to
+  // 12 digits. 1e-6 relative (4e-6 s, a twentieth of a step) leaves room for rounding over 43000
+  // steps and still tells the gyroscopic term's loss, which moves the inversion by 0.98 s.
+  std::cout.precision(12);
+  std::cout << "toy_viscous inversion: grams " << grams << ", milligrams " << milligrams << ", 15 mm unit of length "
+            << unit_length << "\n";
+  EXPECT_NEAR(milligrams, grams, 1e-6 * grams);
+  EXPECT_NEAR(unit_length, grams, 1e-6 * grams);
 }
 
 // Not a test: the inversion time at the default settings (run with --gtest_also_run_disabled_tests).
