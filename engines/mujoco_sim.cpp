@@ -1,4 +1,4 @@
-// MuJoCo 2.2.2 adapter: the scene as MJCF (one free body at G with a ball and a stem geom on a plane), stepped by the shared fixed-step loop.
+// MuJoCo 2.2.2 adapter: the scene as MJCF (one free body at G with a ball and a stem geom on a plane), or the user's own MJCF as written, stepped by the shared fixed-step loop.
 #include "mujoco_sim.h"
 
 #include <mujoco/mujoco.h>
@@ -16,6 +16,7 @@
 
 #include "adapters.h"
 #include "fixed_step.h"
+#include "mujoco_top.h"
 #include "settings.h"
 
 namespace tippe {
@@ -72,6 +73,13 @@ struct MujocoSettings {
   // term, d w3 |w_perp| in the friction rows (1.8 m/s^2 on the toy top), holds a false slip that
   // turns Coulomb tops over ten times early.
   std::string body_frame = "ball_centre";
+  // The user's own MJCF (`tippe import-mjcf`): run as written, with its own options; the keys
+  // above that are given in the scene override its opt fields (timestep, integrator, cone,
+  // impratio, solver, iterations, tolerance, noslip_iterations, noslip_tolerance) and its
+  // ball, stem and floor geoms' solref and solimp. The scene reader resolves the path.
+  std::string model;
+  std::string body;      // the top's body in `model` ("" : the one free body)
+  std::string keyframe;  // the start in `model` ("" : the first keyframe, else qpos0)
 
   template <class V>
   void visit(V& v) {
@@ -90,6 +98,9 @@ struct MujocoSettings {
     v("condim", condim, 0, 6);
     v("rolling_mu", rolling_mu, 0.0, 1e15);
     v("body_frame", body_frame, {"com", "ball_centre"});
+    v("model", model);
+    v("body", body);
+    v("keyframe", keyframe);
   }
 };
 
@@ -129,9 +140,23 @@ void check_combination(const MujocoSettings& s) {
     setting_error("condim", "value " + std::to_string(s.condim) + " is not one of: 0, 1, 3, 4, 6");
 }
 
+bool given(const Scene& scene, const char* key) {
+  const auto e = scene.engines.find("mujoco");
+  return e != scene.engines.end() && e->second.count(key) > 0;
+}
+
 MujocoSettings read_checked_settings(const Scene& scene) {
   MujocoSettings s = read_settings<MujocoSettings>("mujoco", scene);
   check_combination(s);
+  if (!s.model.empty()) {
+    // These shape the bench's own MJCF only; the user's model decides them.
+    for (const char* k : {"body_frame", "condim", "rolling_mu", "noslip_iterations_rolling"})
+      if (given(scene, k))
+        setting_error(k, "not used with engines.mujoco.model (the model decides it: edit the model instead)");
+  } else {
+    for (const char* k : {"body", "keyframe"})
+      if (given(scene, k)) setting_error(k, "only used with engines.mujoco.model");
+  }
   return s;
 }
 
@@ -278,9 +303,7 @@ void install_warning_handler() {
 // Compiles MJCF text through a one-file VFS (no temporary file). Throws std::runtime_error
 // with MuJoCo's message; compiler warnings of a successful load go to `warning`.
 mjModel* compile_mjcf(const std::string& xml, std::string& warning) {
-  // mj_loadXML keeps process-wide "last model" state in 2.2: one load at a time.
-  static std::mutex mutex;
-  std::lock_guard<std::mutex> lock(mutex);
+  std::lock_guard<std::mutex> lock(mujoco_load_mutex());
   // mjVFS holds 2000 file names of 1000 bytes: too large for the stack.
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
@@ -315,6 +338,96 @@ struct MujocoHandles {
   }
 };
 
+// ---- the user's own model (engines.mujoco.model) -------------------------------------------
+
+struct ModelOwner {
+  mjModel* m = nullptr;
+  ~ModelOwner() {
+    if (m) mj_deleteModel(m);
+  }
+};
+
+// The user's model, compiled, with the top found and checked against the scene: a scene whose
+// body, contact or gravity differ from the model's would compare the reference with another
+// top. Throws std::invalid_argument "engines.mujoco.model: ...".
+MjcfTopImport check_user_model(const Scene& scene, const MujocoSettings& s, mjModel** keep, MjTopIds* ids,
+                               std::string* warning) {
+  ModelOwner owner;
+  std::string w;
+  try {
+    owner.m = load_mjcf_file(s.model, w);
+    MjcfTopImport top = analyse_mjcf_top(owner.m, s.model, s.body, s.keyframe, ids);
+    const auto mismatches = mjcf_scene_mismatches(top, scene);
+    if (!mismatches.empty()) {
+      std::string why;
+      for (const auto& x : mismatches) why += (why.empty() ? "" : "; ") + x;
+      throw MjcfImportError(s.model + ": the scene is not this model's top (" + why +
+                            "): MuJoCo would run another body than the reference");
+    }
+    if (keep) std::swap(*keep, owner.m);
+    if (warning) *warning = w;
+    return top;
+  } catch (const MjcfImportError& e) {
+    setting_error("model", e.what());
+  }
+}
+
+// The keys given in [engines.mujoco], applied on the compiled model; returns their names.
+std::vector<std::string> apply_user_overrides(mjModel* m, const Scene& scene, const MujocoSettings& s,
+                                              const MjTopIds& ids) {
+  std::vector<std::string> keys;
+  auto mark = [&](const char* k) {
+    if (!given(scene, k)) return false;
+    keys.push_back(k);
+    return true;
+  };
+  if (mark("timestep")) m->opt.timestep = s.timestep;
+  if (mark("integrator"))
+    m->opt.integrator = s.integrator == "Euler" ? mjINT_EULER : s.integrator == "RK4" ? mjINT_RK4 : mjINT_IMPLICIT;
+  if (mark("cone")) m->opt.cone = s.cone == "elliptic" ? mjCONE_ELLIPTIC : mjCONE_PYRAMIDAL;
+  if (mark("impratio")) m->opt.impratio = s.impratio;
+  if (mark("solver")) m->opt.solver = s.solver == "Newton" ? mjSOL_NEWTON : s.solver == "CG" ? mjSOL_CG : mjSOL_PGS;
+  if (mark("iterations")) m->opt.iterations = s.iterations;
+  if (mark("tolerance")) m->opt.tolerance = s.tolerance;
+  if (mark("noslip_iterations")) m->opt.noslip_iterations = s.noslip_iterations;
+  if (mark("noslip_tolerance")) m->opt.noslip_tolerance = s.noslip_tolerance;
+  // solref and solimp on every geom of the top's contacts and on <pair>s among them, so that
+  // MuJoCo's mixing (solmix, priority) yields exactly the given values.
+  const bool ref = mark("solref"), imp = mark("solimp");
+  auto ours = [&](int g) { return g >= 0 && (g == ids.ball || g == ids.stem || g == ids.floor); };
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (!ours(g)) continue;
+    if (ref) std::copy(s.solref.begin(), s.solref.end(), m->geom_solref + mjNREF * g);
+    if (imp) std::copy(s.solimp.begin(), s.solimp.end(), m->geom_solimp + mjNIMP * g);
+  }
+  for (int p = 0; p < m->npair; ++p) {
+    if (!ours(m->pair_geom1[p]) || !ours(m->pair_geom2[p])) continue;
+    if (ref) std::copy(s.solref.begin(), s.solref.end(), m->pair_solref + mjNREF * p);
+    if (imp) std::copy(s.solimp.begin(), s.solimp.end(), m->pair_solimp + mjNIMP * p);
+  }
+  return keys;
+}
+
+// Whether the scene's start is the keyframe's (the import's): orientation, angular velocity and
+// G's horizontal position and velocity. The vertical ones the reference derives from the floor
+// contact, so they are not compared. 1e-12: the import writes 17 significant digits, so its
+// round trip through the scene text and scene_initial_state is exact to a few ulp; any
+// deliberate change (--set initial.spin=...) is far larger.
+bool same_start(const BodyState& scene, const BodyState& model, double R) {
+  constexpr double tol = 1e-12;
+  const double dq = std::min((scene.q_WB.coeffs() - model.q_WB.coeffs()).norm(),
+                             (scene.q_WB.coeffs() + model.q_WB.coeffs()).norm());
+  const double w = model.w_B.norm();
+  auto h = [](const Vec3& v) { return Vec3(v.x(), v.y(), 0.0); };
+  return dq <= tol && (scene.w_B - model.w_B).norm() <= tol * w &&
+         (h(scene.p_WG) - h(model.p_WG)).norm() <= tol * (R + h(model.p_WG).norm()) &&
+         (h(scene.v_WG) - h(model.v_WG)).norm() <= tol * (h(model.v_WG).norm() + w * R);
+}
+
+const char* integrator_name(int i) { return i == mjINT_EULER ? "Euler" : i == mjINT_RK4 ? "RK4" : "implicit"; }
+const char* solver_name(int i) { return i == mjSOL_PGS ? "PGS" : i == mjSOL_CG ? "CG" : "Newton"; }
+const char* cone_name(int i) { return i == mjCONE_ELLIPTIC ? "elliptic" : "pyramidal"; }
+
 }  // namespace
 
 class MujocoSimulator : public FixedStepSimulator {
@@ -343,6 +456,8 @@ class MujocoSimulator : public FixedStepSimulator {
  private:
   ContactReport read_contacts() const;
   void make_notes(const std::string& compiler_warning);
+  void init_user_model(const Scene& scene);
+  void make_user_notes(const std::string& compiler_warning, const std::vector<std::string>& overridden);
 
   MujocoSettings settings_;
   int condim_ = 0;
@@ -354,6 +469,13 @@ class MujocoSimulator : public FixedStepSimulator {
   int body_id_ = -1, floor_id_ = -1, ball_id_ = -1, stem_id_ = -1;
   int qadr_ = 0, vadr_ = 0;
   double frame_z_ = 0.0;  // the body frame's origin F = G + frame_z_ e_Z
+  // The user's model: its body frame F is the model's own, turned by q_FB_ from the principal
+  // frame B, with G at p_FG_F_ in it.
+  bool user_ = false;
+  MjcfTopImport top_;
+  Quat q_FB_ = Quat::Identity();
+  Vec3 p_FG_F_ = Vec3::Zero();
+  bool keyframe_start_ = false;
   ContactReport report_;
   std::string limit_;
   // MuJoCo met a NaN or |x| > mjMAXVAL in qpos, qvel or qacc and reset mjData to the model's
@@ -365,6 +487,10 @@ class MujocoSimulator : public FixedStepSimulator {
 MujocoSimulator::MujocoSimulator(const Scene& scene)
     : FixedStepSimulator(scene), settings_(read_checked_settings(scene)) {
   install_warning_handler();
+  if (!settings_.model.empty()) {
+    init_user_model(scene);
+    return;
+  }
   condim_ = used_condim(settings_, scene);
   frame_z_ = frame_origin_z(settings_, body());
   std::string compiler_warning;
@@ -392,7 +518,133 @@ MujocoSimulator::MujocoSimulator(const Scene& scene)
   start(settings_.timestep);
 }
 
+void MujocoSimulator::init_user_model(const Scene& scene) {
+  user_ = true;
+  std::string compiler_warning;
+  MjTopIds ids;
+  check_user_model(scene, settings_, &mj_.model, &ids, &compiler_warning);
+  m_ = mj_.model;
+  const std::vector<std::string> overridden = apply_user_overrides(m_, scene, settings_, ids);
+  // Read again: the contact as the overrides leave it (solref, solimp), for the notes and settings.
+  top_ = analyse_mjcf_top(m_, settings_.model, settings_.body, settings_.keyframe);
+  d_ = mj_.data = mj_makeData(m_);
+  if (!d_) throw std::runtime_error("mujoco: mj_makeData failed");
+  body_id_ = ids.body;
+  floor_id_ = ids.floor;
+  ball_id_ = ids.ball;
+  stem_id_ = ids.stem;
+  qadr_ = ids.qadr;
+  vadr_ = ids.vadr;
+  q_FB_ = top_.q_FB;
+  p_FG_F_ = top_.p_FG_F;
+  condim_ = top_.condim;
+
+  const BodyState x0 = scene_initial_state(scene);
+  keyframe_start_ = same_start(x0, top_.start, body().R);
+  if (keyframe_start_) {
+    // The keyframe's own numbers: the run is plain MuJoCo's from it, bit for bit.
+    if (ids.key >= 0) mj_resetDataKeyframe(m_, d_, ids.key);
+    else mj_resetData(m_, d_);
+  } else {
+    // The scene's start (e.g. a --set initial.spin), converted to the model's frame F.
+    mj_resetData(m_, d_);
+    const Quat q_WF = (x0.q_WB * q_FB_.conjugate()).normalized();
+    const Vec3 r_FG_W = q_WF * p_FG_F_;
+    const Vec3 w_W = x0.q_WB * x0.w_B;
+    const Vec3 p_WF = x0.p_WG - r_FG_W, v_WF = x0.v_WG - w_W.cross(r_FG_W);
+    const Vec3 w_F = q_FB_ * x0.w_B;
+    mjtNum* q = d_->qpos + qadr_;
+    mjtNum* v = d_->qvel + vadr_;
+    q[0] = p_WF.x(), q[1] = p_WF.y(), q[2] = p_WF.z();
+    q[3] = q_WF.w(), q[4] = q_WF.x(), q[5] = q_WF.y(), q[6] = q_WF.z();
+    v[0] = v_WF.x(), v[1] = v_WF.y(), v[2] = v_WF.z();
+    v[3] = w_F.x(), v[4] = w_F.y(), v[5] = w_F.z();
+  }
+  d_->time = 0.0;
+  // Contacts at t = 0 for observe() before the first step; the warm start is kept as the reset
+  // left it, so that the steps are plain MuJoCo's.
+  std::vector<mjtNum> warm(d_->qacc_warmstart, d_->qacc_warmstart + m_->nv);
+  mj_forward(m_, d_);
+  std::copy(warm.begin(), warm.end(), d_->qacc_warmstart);
+  report_ = read_contacts();
+  make_user_notes(compiler_warning, overridden);
+  start(m_->opt.timestep);
+}
+
+void MujocoSimulator::make_user_notes(const std::string& compiler_warning, const std::vector<std::string>& overridden) {
+  auto g = [](double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  };
+  const mjOption& o = m_->opt;
+  const std::string from = top_.keyframe_index >= 0 ? "keyframe '" + top_.keyframe + "'" : "qpos0";
+  notes_.push_back("MuJoCo runs the model " + settings_.model + " as written (body '" + top_.body + "'), not the bench's MJCF");
+  notes_.push_back(keyframe_start_ ? "start: " + from + " of the model, as written"
+                                   : "start: the scene's initial state, not " + from + " of the model (the scene changes it)");
+  notes_.push_back("model options: timestep " + g(o.timestep) + ", integrator " + integrator_name(o.integrator) + ", cone " +
+                   cone_name(o.cone) + ", solver " + solver_name(o.solver) + " (iterations " + std::to_string(o.iterations) +
+                   ", tolerance " + g(o.tolerance) + "), impratio " + g(o.impratio) + ", noslip_iterations " +
+                   std::to_string(o.noslip_iterations));
+  if (!overridden.empty()) {
+    std::string keys;
+    for (const auto& k : overridden) keys += (keys.empty() ? "" : ", ") + k;
+    notes_.push_back("overridden by the scene (engines.mujoco): " + keys);
+  }
+  const mjtNum* fr = top_.contact_friction.data();
+  notes_.push_back("ball-floor contact as compiled: condim " + std::to_string(top_.condim) + ", friction " + g(fr[0]) + " " +
+                   g(fr[2]) + " " + g(fr[3]) + ", margin " + g(top_.contact_margin));
+  // The body frame's origin F relative to G, in the principal frame B.
+  const Vec3 f_B = q_FB_.conjugate() * (-p_FG_F_);
+  notes_.push_back("body frame: the model's own, origin at (" + g(f_B.x()) + ", " + g(f_B.y()) + ", " + g(f_B.z()) +
+                   ") from G in the principal frame: MuJoCo's results depend on it");
+  // MuJoCo's refsafe rule on the contact's solref (engine_core_constraint.c, getsolparam).
+  for (int g_id : {ball_id_, floor_id_}) {
+    const mjtNum tc = m_->geom_solref[mjNREF * g_id];
+    if (tc > 0 && tc < 2 * o.timestep && !(m_->opt.disableflags & mjDSBL_REFSAFE)) {
+      notes_.push_back("solref timeconst " + g(tc) + " of geom '" + (mj_id2name(m_, mjOBJ_GEOM, g_id) ? mj_id2name(m_, mjOBJ_GEOM, g_id) : "") +
+                       "' raised by MuJoCo to 2 timestep = " + g(2 * o.timestep) + " (its refsafe rule)");
+      break;
+    }
+  }
+  if (condim_ >= 3 && o.cone == mjCONE_PYRAMIDAL) notes_.push_back("friction cone approximated by MuJoCo's pyramid (cone pyramidal)");
+  if (condim_ >= 3)
+    notes_.push_back("while slipping, MuJoCo's convex contact pushes the ball off the floor: the contact hops (intermittent normal force, many switch events)");
+  if (o.integrator != mjINT_RK4) notes_.push_back(std::string("integrator ") + integrator_name(o.integrator) + ": first order in the timestep");
+  if (!compiler_warning.empty()) notes_.push_back("mujoco compiler: " + compiler_warning);
+}
+
 SettingsList MujocoSimulator::settings() const {
+  if (user_) {
+    const mjOption& o = m_->opt;
+    auto n17 = [](const mjtNum* v, int n) {
+      std::string out = "[";
+      for (int i = 0; i < n; ++i) out += (i ? ", " : "") + num(v[i]);
+      return out + "]";
+    };
+    SettingsList list;
+    list.emplace_back("model", settings_.model);
+    list.emplace_back("body", top_.body);
+    list.emplace_back("keyframe", top_.keyframe_index >= 0 ? top_.keyframe : "(qpos0)");
+    list.emplace_back("start", keyframe_start_ ? "keyframe" : "scene");
+    list.emplace_back("timestep", num(o.timestep));
+    list.emplace_back("integrator", integrator_name(o.integrator));
+    list.emplace_back("cone", cone_name(o.cone));
+    list.emplace_back("impratio", num(o.impratio));
+    list.emplace_back("solver", solver_name(o.solver));
+    list.emplace_back("iterations", std::to_string(o.iterations));
+    list.emplace_back("tolerance", num(o.tolerance));
+    list.emplace_back("noslip_iterations", std::to_string(o.noslip_iterations));
+    list.emplace_back("noslip_tolerance", num(o.noslip_tolerance));
+    list.emplace_back("condim_used", std::to_string(top_.condim));
+    list.emplace_back("friction_used", n17(top_.contact_friction.data(), 5));
+    list.emplace_back("margin_used", num(top_.contact_margin));
+    list.emplace_back("solref_ball", n17(m_->geom_solref + mjNREF * ball_id_, mjNREF));
+    list.emplace_back("solimp_ball", n17(m_->geom_solimp + mjNIMP * ball_id_, mjNIMP));
+    list.emplace_back("solref_floor", n17(m_->geom_solref + mjNREF * floor_id_, mjNREF));
+    list.emplace_back("solimp_floor", n17(m_->geom_solimp + mjNIMP * floor_id_, mjNIMP));
+    return list;
+  }
   SettingsList list = list_settings(settings_);
   const Vec3 f = used_friction(settings_, scene());
   list.emplace_back("condim_used", std::to_string(condim_));
@@ -499,6 +751,17 @@ BodyState MujocoSimulator::engine_state() const {
   }
   const mjtNum* q = d_->qpos + qadr_;
   const mjtNum* v = d_->qvel + vadr_;
+  if (user_) {
+    // F is the model's frame: B = F turned by q_FB, G at p_FG_F in F.
+    const Quat q_WF = Quat(q[3], q[4], q[5], q[6]).normalized();
+    const Vec3 w_F(v[3], v[4], v[5]);
+    x.q_WB = q_WF * q_FB_;
+    x.w_B = q_FB_.conjugate() * w_F;
+    const Vec3 r_FG_W = q_WF * p_FG_F_;
+    x.p_WG = Vec3(q[0], q[1], q[2]) + r_FG_W;
+    x.v_WG = Vec3(v[0], v[1], v[2]) + (q_WF * w_F).cross(r_FG_W);
+    return x;
+  }
   x.q_WB = Quat(q[3], q[4], q[5], q[6]).normalized();
   // MuJoCo's free joint angular velocity is in the body (local) frame.
   x.w_B = Vec3(v[3], v[4], v[5]);
@@ -557,7 +820,7 @@ MujocoModelReadback MujocoSimulator::readback() const {
   r.inertia = Vec3(m_->body_inertia[3 * b], m_->body_inertia[3 * b + 1], m_->body_inertia[3 * b + 2]);
   r.iquat_B = Quat(m_->body_iquat[4 * b], m_->body_iquat[4 * b + 1], m_->body_iquat[4 * b + 2], m_->body_iquat[4 * b + 3]);
   r.timestep = m_->opt.timestep;
-  r.frame_origin_G = Vec3(0.0, 0.0, frame_z_);
+  r.frame_origin_G = user_ ? Vec3(q_FB_.conjugate() * (-p_FG_F_)) : Vec3(0.0, 0.0, frame_z_);
   r.nq = m_->nq;
   r.nv = m_->nv;
   return r;
@@ -581,9 +844,18 @@ std::unique_ptr<Simulator> make_mujoco_simulator(const Scene& scene) {
   return std::make_unique<MujocoSimulator>(scene);
 }
 
-void validate_mujoco_settings(const Scene& scene) { (void)read_checked_settings(scene); }
+void validate_mujoco_settings(const Scene& scene) {
+  const MujocoSettings s = read_checked_settings(scene);
+  if (!s.model.empty()) (void)check_user_model(scene, s, nullptr, nullptr, nullptr);
+}
 
-std::string mujoco_mjcf(const Scene& scene) { return build_mjcf(scene, read_checked_settings(scene)); }
+std::string mujoco_mjcf(const Scene& scene) {
+  const MujocoSettings s = read_checked_settings(scene);
+  if (!s.model.empty())
+    throw std::invalid_argument("engines.mujoco.model: the scene runs the user's model " + s.model +
+                                "; that file is its MuJoCo model (export-mjcf writes the bench's own)");
+  return build_mjcf(scene, s);
+}
 
 std::vector<std::string> mujoco_mjcf_missing(const Scene& scene) {
   std::vector<std::string> out;

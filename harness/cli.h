@@ -62,6 +62,7 @@ inline int error_exit(const std::exception_ptr& e, bool print = true) {
 // One function per subcommand, each in its own cli_NAME.cpp; main.cpp lists them.
 Command setup_run(CLI::App& app);
 Command setup_export_mjcf(CLI::App& app);
+Command setup_import_mjcf(CLI::App& app);
 Command setup_info(CLI::App& app);
 Command setup_compare(CLI::App& app);  // and setup_report, in cli_compare.cpp
 Command setup_report(CLI::App& app);

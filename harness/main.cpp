@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
   CLI::App app{"tippe: the tippe-top verification bench"};
   app.require_subcommand(1);
   // Adding a subcommand: write cli_NAME.cpp with setup_NAME, declare it in cli.h, list it here.
-  const cli::Setup commands[] = {cli::setup_run, cli::setup_export_mjcf, cli::setup_info,
+  const cli::Setup commands[] = {cli::setup_run, cli::setup_export_mjcf, cli::setup_import_mjcf, cli::setup_info,
                                   cli::setup_compare, cli::setup_report, cli::setup_sweep,
                                   cli::setup_gate};
   std::map<const CLI::App*, cli::Action> actions;
