@@ -444,6 +444,11 @@ class MujocoSimulator : public FixedStepSimulator {
   MujocoModelReadback readback() const;
   std::vector<double> qpos() const { return std::vector<double>(d_->qpos, d_->qpos + m_->nq); }
   std::vector<double> qvel() const { return std::vector<double>(d_->qvel, d_->qvel + m_->nv); }
+  std::vector<double> body_pose() const {
+    std::vector<double> out(d_->xpos + 3 * body_id_, d_->xpos + 3 * body_id_ + 3);
+    out.insert(out.end(), d_->xquat + 4 * body_id_, d_->xquat + 4 * body_id_ + 4);
+    return out;
+  }
 
  protected:
   void engine_step() override;
@@ -454,7 +459,8 @@ class MujocoSimulator : public FixedStepSimulator {
   long long engine_solver_iterations() const override { return solver_iterations_; }
 
  private:
-  ContactReport read_contacts() const;
+  ContactReport read_contacts() const { return read_contacts(d_); }
+  ContactReport read_contacts(const mjData* d) const;
   void make_notes(const std::string& compiler_warning);
   void init_user_model(const Scene& scene);
   void make_user_notes(const std::string& compiler_warning, const std::vector<std::string>& overridden);
@@ -561,12 +567,16 @@ void MujocoSimulator::init_user_model(const Scene& scene) {
     v[3] = w_F.x(), v[4] = w_F.y(), v[5] = w_F.z();
   }
   d_->time = 0.0;
-  // Contacts at t = 0 for observe() before the first step; the warm start is kept as the reset
-  // left it, so that the steps are plain MuJoCo's.
-  std::vector<mjtNum> warm(d_->qacc_warmstart, d_->qacc_warmstart + m_->nv);
-  mj_forward(m_, d_);
-  std::copy(warm.begin(), warm.end(), d_->qacc_warmstart);
-  report_ = read_contacts();
+  // Contacts at t = 0 for observe() before the first step, from a copy: an mj_forward on d_
+  // itself changes the first Euler step in its last bits (even with qacc_warmstart kept), and
+  // the steps must be plain MuJoCo's.
+  {
+    std::unique_ptr<mjData, void (*)(mjData*)> scratch(mj_makeData(m_), mj_deleteData);
+    if (!scratch) throw std::runtime_error("mujoco: mj_makeData failed");
+    mj_copyData(scratch.get(), m_, d_);
+    mj_forward(m_, scratch.get());
+    report_ = read_contacts(scratch.get());
+  }
   make_user_notes(compiler_warning, overridden);
   start(m_->opt.timestep);
 }
@@ -783,12 +793,12 @@ void MujocoSimulator::apply_force_W(const Vec3& f_W, const Vec3& p_W) {
   mj_applyFT(m_, d_, force, torque, point, body_id_, d_->qfrc_applied);
 }
 
-ContactReport MujocoSimulator::read_contacts() const {
+ContactReport MujocoSimulator::read_contacts(const mjData* data) const {
   ContactReport r;
   Vec3 moment = Vec3::Zero();
   double weight = 0.0;
-  for (int i = 0; i < d_->ncon; ++i) {
-    const mjContact& c = d_->contact[i];
+  for (int i = 0; i < data->ncon; ++i) {
+    const mjContact& c = data->contact[i];
     if (c.exclude != 0 || c.efc_address < 0) continue;
     const int g = c.geom1 == floor_id_ ? c.geom2 : (c.geom2 == floor_id_ ? c.geom1 : -1);
     if (g == ball_id_) r.ball = true;
@@ -796,7 +806,7 @@ ContactReport MujocoSimulator::read_contacts() const {
     else continue;
     mjtNum f[6];
     // In the contact frame, whose first axis is the normal (+z here): f[0] is the normal force.
-    mj_contactForce(m_, d_, i, f);
+    mj_contactForce(m_, data, i, f);
     r.normal_force += f[0];
     (g == ball_id_ ? r.normal_force_ball : r.normal_force_stem) += f[0];
     if (f[0] > 0) {
@@ -839,6 +849,7 @@ MujocoModelReadback mujoco_model_readback(const Simulator& sim) {
 }
 std::vector<double> mujoco_qpos(const Simulator& sim) { return as_mujoco(sim, "mujoco_qpos").qpos(); }
 std::vector<double> mujoco_qvel(const Simulator& sim) { return as_mujoco(sim, "mujoco_qvel").qvel(); }
+std::vector<double> mujoco_body_pose(const Simulator& sim) { return as_mujoco(sim, "mujoco_body_pose").body_pose(); }
 
 std::unique_ptr<Simulator> make_mujoco_simulator(const Scene& scene) {
   return std::make_unique<MujocoSimulator>(scene);
