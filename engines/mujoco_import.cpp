@@ -2,7 +2,11 @@
 #include "mujoco_top.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <locale>
 #include <memory>
 #include <sstream>
@@ -458,12 +462,31 @@ std::mutex& mujoco_load_mutex() {
   return mutex;
 }
 
+// MuJoCo's messages span lines (the XML parser's); a message of the bench is one line.
+std::string one_line(const char* text) {
+  std::string out;
+  for (const char* c = text; *c; ++c) {
+    const bool space = *c == '\n' || *c == '\r' || *c == '\t' || *c == ' ';
+    if (space && (out.empty() || out.back() == ' ')) continue;
+    out += space ? ' ' : *c;
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
 mjModel* load_mjcf_file(const std::string& path, std::string& warning) {
+  // The file's own failure first, in the words every other input file uses.
+  {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw MjcfImportError(path + ": cannot read: is a directory");
+    std::ifstream in(path);
+    if (!in) throw MjcfImportError(path + ": cannot read: " + std::strerror(errno));
+  }
   std::lock_guard<std::mutex> lock(mujoco_load_mutex());
   char error[1024] = "";
   mjModel* m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
-  if (!m) throw MjcfImportError(path + ": MuJoCo cannot load it: " + (*error ? error : "unknown error"));
-  warning = error;
+  if (!m) throw MjcfImportError(path + ": MuJoCo cannot load it: " + (*error ? one_line(error) : "unknown error"));
+  warning = one_line(error);
   return m;
 }
 
