@@ -367,6 +367,8 @@ class Analyser {
     out.condim = c.dim;
     for (int i = 0; i < 5; ++i) out.contact_friction[i] = c.friction[i];
     out.contact_margin = c.includemargin;
+    for (int i = 0; i < 2; ++i) out.contact_solref[i] = c.solref[i];
+    for (int i = 0; i < 5; ++i) out.contact_solimp[i] = c.solimp[i];
     ContactSpec& s = out.contact;
     s.stem = out.stem;
     switch (c.dim) {

@@ -38,6 +38,8 @@ struct MjcfTopImport {
   int condim = 0;               // of the ball-floor contact
   std::array<double, 5> contact_friction{0, 0, 0, 0, 0};  // mjContact.friction of the ball-floor contact
   double contact_margin = 0.0;  // mjContact.includemargin (margin - gap)
+  std::array<double, 2> contact_solref{0, 0};              // mjContact.solref, as given (before refsafe)
+  std::array<double, 5> contact_solimp{0, 0, 0, 0, 0};     // mjContact.solimp
   BodyState start;              // exact state of G at the start (t = 0)
   double start_gap = 0.0;       // lowest point of the body above the floor at the start (< 0: inside)
   double start_vz_centre = 0.0; // vertical velocity of the centre of the sphere that touches (O or P)

@@ -16,93 +16,13 @@
 
 #include "adapters.h"
 #include "fixed_step.h"
+#include "mujoco_settings.h"
 #include "mujoco_top.h"
+#include "mujoco_user_model.h"
 #include "settings.h"
 
 namespace tippe {
 namespace {
-
-// Every setting of the MuJoCo model that decides accuracy, read from [engines.mujoco].
-struct MujocoSettings {
-  // Small against the spin period (2 pi / 5 ~ 1.3 dimensionless, 0.04 s for the toy) and
-  // 20 steps per contact time constant (solref[0] = 0.002).
-  double timestep = 1e-4;
-  // "RK4": 4th order, so the explicit gyroscopic term w x I w of a fast spinning body causes
-  // no visible energy drift; "Euler" (MuJoCo's default, semi-implicit, 1st order) grows the
-  // nutation energy by O((w h)^2) per step; "implicit" (2.2: velocity-implicit with the RNE
-  // derivatives) is 1st order and numerically damped. RK4 costs 4 forward passes a step.
-  std::string integrator = "RK4";
-  // "elliptic" is the Coulomb cone itself (|F_t| <= mu F_n, isotropic); "pyramidal" is
-  // MuJoCo's default polyhedral approximation of it.
-  std::string cone = "elliptic";
-  // Friction-to-normal impedance ratio; MuJoCo's default: friction exactly as soft as the normal.
-  double impratio = 1.0;
-  // Newton: MuJoCo's default, converges quadratically; exact for a handful of constraint rows.
-  std::string solver = "Newton";
-  // A cap Newton does not reach at this tolerance for one body with at most 3 contacts.
-  int iterations = 100;
-  // Below MuJoCo's 1e-8 default so that solver error stays far below the compared quantities;
-  // it costs an iteration or two.
-  double tolerance = 1e-10;
-  // MuJoCo's default: no post-pass; the soft contact's own friction is the law being tested.
-  int noslip_iterations = 0;
-  // friction = rolling: the noslip pass removes the creep that soft friction allows, so the
-  // contact point really sticks.
-  int noslip_iterations_rolling = 10;
-  // Same order as the main tolerance (MuJoCo's default is 1e-6); used only when noslip runs.
-  double noslip_tolerance = 1e-10;
-  // [timeconst, dampratio]: MuJoCo's default 0.02 s leaves the toy top resting 2.6 % of R deep;
-  // 0.002 gives 2.6e-4 R there (4.5e-7 R for the dimensionless top), is critically damped, and
-  // keeps MuJoCo's stability rule timeconst >= 2 timestep for every timestep up to 1e-3.
-  std::vector<double> solref = {0.002, 1.0};
-  // [dmin, dmax, width, midpoint, power]: MuJoCo's default impedance profile.
-  std::vector<double> solimp = {0.9, 0.95, 0.001, 0.5, 2.0};
-  // 0: derived from the scene's friction law (1 none/viscous/gliding, 3 coulomb/rolling, 4 with
-  // drilling); 1, 3, 4 or 6 force that contact dimensionality (diagnostic).
-  int condim = 0;
-  // Friction coefficient that stands in for the rolling constraint (friction = rolling).
-  double rolling_mu = 1e3;
-  // Where the free body's frame (and so its joint) has its origin: a modelling choice, not
-  // physics, yet MuJoCo 2.2.2's answer depends on it (BENCHMARKS.md, "MuJoCo's body frame").
-  // MuJoCo applies its soft-constraint law to J qacc and never computes J-dot qvel
-  // (mj_fwdConstraint: efc_b = J qacc_smooth - aref); for a free joint that omitted term depends
-  // on the frame origin. "ball_centre" (the default): the origin at the ball's centre O, where the
-  // term is exactly zero for a sphere on a plane, so MuJoCo's contact law acts on the true gap and
-  // slip; it is also the frame of MuJoCo's tutorial top and of most hand-written models.
-  // "com": the origin at the centre of mass G (the bench's first choice), where the omitted
-  // term, d w3 |w_perp| in the friction rows (1.8 m/s^2 on the toy top), holds a false slip that
-  // turns Coulomb tops over ten times early.
-  std::string body_frame = "ball_centre";
-  // The user's own MJCF (`tippe import-mjcf`): run as written, with its own options; the keys
-  // above that are given in the scene override its opt fields (timestep, integrator, cone,
-  // impratio, solver, iterations, tolerance, noslip_iterations, noslip_tolerance) and its
-  // ball, stem and floor geoms' solref and solimp. The scene reader resolves the path.
-  std::string model;
-  std::string body;      // the top's body in `model` ("" : the one free body)
-  std::string keyframe;  // the start in `model` ("" : the first keyframe, else qpos0)
-
-  template <class V>
-  void visit(V& v) {
-    v("timestep", timestep, 1e-8, 0.1);
-    v("integrator", integrator, {"Euler", "RK4", "implicit"});
-    v("cone", cone, {"elliptic", "pyramidal"});
-    v("impratio", impratio, 1e-6, 1e6);
-    v("solver", solver, {"Newton", "CG", "PGS"});
-    v("iterations", iterations, 1, 1000000);
-    v("tolerance", tolerance, 0.0, 1.0);
-    v("noslip_iterations", noslip_iterations, 0, 1000000);
-    v("noslip_iterations_rolling", noslip_iterations_rolling, 0, 1000000);
-    v("noslip_tolerance", noslip_tolerance, 0.0, 1.0);
-    v("solref", solref, 2);
-    v("solimp", solimp, 5);
-    v("condim", condim, 0, 6);
-    v("rolling_mu", rolling_mu, 0.0, 1e15);
-    v("body_frame", body_frame, {"com", "ball_centre"});
-    v("model", model);
-    v("body", body);
-    v("keyframe", keyframe);
-  }
-};
 
 [[noreturn]] void setting_error(const std::string& key, const std::string& why) {
   throw std::invalid_argument("engines.mujoco." + key + ": " + why);
@@ -140,22 +60,17 @@ void check_combination(const MujocoSettings& s) {
     setting_error("condim", "value " + std::to_string(s.condim) + " is not one of: 0, 1, 3, 4, 6");
 }
 
-bool given(const Scene& scene, const char* key) {
-  const auto e = scene.engines.find("mujoco");
-  return e != scene.engines.end() && e->second.count(key) > 0;
-}
-
 MujocoSettings read_checked_settings(const Scene& scene) {
   MujocoSettings s = read_settings<MujocoSettings>("mujoco", scene);
   check_combination(s);
   if (!s.model.empty()) {
     // These shape the bench's own MJCF only; the user's model decides them.
     for (const char* k : {"body_frame", "condim", "rolling_mu", "noslip_iterations_rolling"})
-      if (given(scene, k))
+      if (mujoco_setting_given(scene, k))
         setting_error(k, "not used with engines.mujoco.model (the model decides it: edit the model instead)");
   } else {
     for (const char* k : {"body", "keyframe"})
-      if (given(scene, k)) setting_error(k, "only used with engines.mujoco.model");
+      if (mujoco_setting_given(scene, k)) setting_error(k, "only used with engines.mujoco.model");
   }
   return s;
 }
@@ -338,96 +253,6 @@ struct MujocoHandles {
   }
 };
 
-// ---- the user's own model (engines.mujoco.model) -------------------------------------------
-
-struct ModelOwner {
-  mjModel* m = nullptr;
-  ~ModelOwner() {
-    if (m) mj_deleteModel(m);
-  }
-};
-
-// The user's model, compiled, with the top found and checked against the scene: a scene whose
-// body, contact or gravity differ from the model's would compare the reference with another
-// top. Throws std::invalid_argument "engines.mujoco.model: ...".
-MjcfTopImport check_user_model(const Scene& scene, const MujocoSettings& s, mjModel** keep, MjTopIds* ids,
-                               std::string* warning) {
-  ModelOwner owner;
-  std::string w;
-  try {
-    owner.m = load_mjcf_file(s.model, w);
-    MjcfTopImport top = analyse_mjcf_top(owner.m, s.model, s.body, s.keyframe, ids);
-    const auto mismatches = mjcf_scene_mismatches(top, scene);
-    if (!mismatches.empty()) {
-      std::string why;
-      for (const auto& x : mismatches) why += (why.empty() ? "" : "; ") + x;
-      throw MjcfImportError(s.model + ": the scene is not this model's top (" + why +
-                            "): MuJoCo would run another body than the reference");
-    }
-    if (keep) std::swap(*keep, owner.m);
-    if (warning) *warning = w;
-    return top;
-  } catch (const MjcfImportError& e) {
-    setting_error("model", e.what());
-  }
-}
-
-// The keys given in [engines.mujoco], applied on the compiled model; returns their names.
-std::vector<std::string> apply_user_overrides(mjModel* m, const Scene& scene, const MujocoSettings& s,
-                                              const MjTopIds& ids) {
-  std::vector<std::string> keys;
-  auto mark = [&](const char* k) {
-    if (!given(scene, k)) return false;
-    keys.push_back(k);
-    return true;
-  };
-  if (mark("timestep")) m->opt.timestep = s.timestep;
-  if (mark("integrator"))
-    m->opt.integrator = s.integrator == "Euler" ? mjINT_EULER : s.integrator == "RK4" ? mjINT_RK4 : mjINT_IMPLICIT;
-  if (mark("cone")) m->opt.cone = s.cone == "elliptic" ? mjCONE_ELLIPTIC : mjCONE_PYRAMIDAL;
-  if (mark("impratio")) m->opt.impratio = s.impratio;
-  if (mark("solver")) m->opt.solver = s.solver == "Newton" ? mjSOL_NEWTON : s.solver == "CG" ? mjSOL_CG : mjSOL_PGS;
-  if (mark("iterations")) m->opt.iterations = s.iterations;
-  if (mark("tolerance")) m->opt.tolerance = s.tolerance;
-  if (mark("noslip_iterations")) m->opt.noslip_iterations = s.noslip_iterations;
-  if (mark("noslip_tolerance")) m->opt.noslip_tolerance = s.noslip_tolerance;
-  // solref and solimp on every geom of the top's contacts and on <pair>s among them, so that
-  // MuJoCo's mixing (solmix, priority) yields exactly the given values.
-  const bool ref = mark("solref"), imp = mark("solimp");
-  auto ours = [&](int g) { return g >= 0 && (g == ids.ball || g == ids.stem || g == ids.floor); };
-  for (int g = 0; g < m->ngeom; ++g) {
-    if (!ours(g)) continue;
-    if (ref) std::copy(s.solref.begin(), s.solref.end(), m->geom_solref + mjNREF * g);
-    if (imp) std::copy(s.solimp.begin(), s.solimp.end(), m->geom_solimp + mjNIMP * g);
-  }
-  for (int p = 0; p < m->npair; ++p) {
-    if (!ours(m->pair_geom1[p]) || !ours(m->pair_geom2[p])) continue;
-    if (ref) std::copy(s.solref.begin(), s.solref.end(), m->pair_solref + mjNREF * p);
-    if (imp) std::copy(s.solimp.begin(), s.solimp.end(), m->pair_solimp + mjNIMP * p);
-  }
-  return keys;
-}
-
-// Whether the scene's start is the keyframe's (the import's): orientation, angular velocity and
-// G's horizontal position and velocity. The vertical ones the reference derives from the floor
-// contact, so they are not compared. 1e-12: the import writes 17 significant digits, so its
-// round trip through the scene text and scene_initial_state is exact to a few ulp; any
-// deliberate change (--set initial.spin=...) is far larger.
-bool same_start(const BodyState& scene, const BodyState& model, double R) {
-  constexpr double tol = 1e-12;
-  const double dq = std::min((scene.q_WB.coeffs() - model.q_WB.coeffs()).norm(),
-                             (scene.q_WB.coeffs() + model.q_WB.coeffs()).norm());
-  const double w = model.w_B.norm();
-  auto h = [](const Vec3& v) { return Vec3(v.x(), v.y(), 0.0); };
-  return dq <= tol && (scene.w_B - model.w_B).norm() <= tol * w &&
-         (h(scene.p_WG) - h(model.p_WG)).norm() <= tol * (R + h(model.p_WG).norm()) &&
-         (h(scene.v_WG) - h(model.v_WG)).norm() <= tol * (h(model.v_WG).norm() + w * R);
-}
-
-const char* integrator_name(int i) { return i == mjINT_EULER ? "Euler" : i == mjINT_RK4 ? "RK4" : "implicit"; }
-const char* solver_name(int i) { return i == mjSOL_PGS ? "PGS" : i == mjSOL_CG ? "CG" : "Newton"; }
-const char* cone_name(int i) { return i == mjCONE_ELLIPTIC ? "elliptic" : "pyramidal"; }
-
 }  // namespace
 
 class MujocoSimulator : public FixedStepSimulator {
@@ -463,7 +288,6 @@ class MujocoSimulator : public FixedStepSimulator {
   ContactReport read_contacts(const mjData* d) const;
   void make_notes(const std::string& compiler_warning);
   void init_user_model(const Scene& scene);
-  void make_user_notes(const std::string& compiler_warning, const std::vector<std::string>& overridden);
 
   MujocoSettings settings_;
   int condim_ = 0;
@@ -482,6 +306,7 @@ class MujocoSimulator : public FixedStepSimulator {
   Quat q_FB_ = Quat::Identity();
   Vec3 p_FG_F_ = Vec3::Zero();
   bool keyframe_start_ = false;
+  MjTopIds ids_;
   ContactReport report_;
   std::string limit_;
   // MuJoCo met a NaN or |x| > mjMAXVAL in qpos, qvel or qacc and reset mjData to the model's
@@ -527,7 +352,7 @@ MujocoSimulator::MujocoSimulator(const Scene& scene)
 void MujocoSimulator::init_user_model(const Scene& scene) {
   user_ = true;
   std::string compiler_warning;
-  MjTopIds ids;
+  MjTopIds& ids = ids_;
   check_user_model(scene, settings_, &mj_.model, &ids, &compiler_warning);
   m_ = mj_.model;
   const std::vector<std::string> overridden = apply_user_overrides(m_, scene, settings_, ids);
@@ -577,84 +402,13 @@ void MujocoSimulator::init_user_model(const Scene& scene) {
     mj_forward(m_, scratch.get());
     report_ = read_contacts(scratch.get());
   }
-  make_user_notes(compiler_warning, overridden);
+  notes_ = user_model_notes(m_, top_, settings_.model, keyframe_start_, overridden, compiler_warning);
   start(m_->opt.timestep);
 }
 
-void MujocoSimulator::make_user_notes(const std::string& compiler_warning, const std::vector<std::string>& overridden) {
-  auto g = [](double v) {
-    std::ostringstream os;
-    os << v;
-    return os.str();
-  };
-  const mjOption& o = m_->opt;
-  const std::string from = top_.keyframe_index >= 0 ? "keyframe '" + top_.keyframe + "'" : "qpos0";
-  notes_.push_back("MuJoCo runs the model " + settings_.model + " as written (body '" + top_.body + "'), not the bench's MJCF");
-  notes_.push_back(keyframe_start_ ? "start: " + from + " of the model, as written"
-                                   : "start: the scene's initial state, not " + from + " of the model (the scene changes it)");
-  notes_.push_back("model options: timestep " + g(o.timestep) + ", integrator " + integrator_name(o.integrator) + ", cone " +
-                   cone_name(o.cone) + ", solver " + solver_name(o.solver) + " (iterations " + std::to_string(o.iterations) +
-                   ", tolerance " + g(o.tolerance) + "), impratio " + g(o.impratio) + ", noslip_iterations " +
-                   std::to_string(o.noslip_iterations));
-  if (!overridden.empty()) {
-    std::string keys;
-    for (const auto& k : overridden) keys += (keys.empty() ? "" : ", ") + k;
-    notes_.push_back("overridden by the scene (engines.mujoco): " + keys);
-  }
-  const mjtNum* fr = top_.contact_friction.data();
-  notes_.push_back("ball-floor contact as compiled: condim " + std::to_string(top_.condim) + ", friction " + g(fr[0]) + " " +
-                   g(fr[2]) + " " + g(fr[3]) + ", margin " + g(top_.contact_margin));
-  // The body frame's origin F relative to G, in the principal frame B.
-  const Vec3 f_B = q_FB_.conjugate() * (-p_FG_F_);
-  notes_.push_back("body frame: the model's own, origin at (" + g(f_B.x()) + ", " + g(f_B.y()) + ", " + g(f_B.z()) +
-                   ") from G in the principal frame: MuJoCo's results depend on it");
-  // MuJoCo's refsafe rule on the contact's solref (engine_core_constraint.c, getsolparam).
-  for (int g_id : {ball_id_, floor_id_}) {
-    const mjtNum tc = m_->geom_solref[mjNREF * g_id];
-    if (tc > 0 && tc < 2 * o.timestep && !(m_->opt.disableflags & mjDSBL_REFSAFE)) {
-      notes_.push_back("solref timeconst " + g(tc) + " of geom '" + (mj_id2name(m_, mjOBJ_GEOM, g_id) ? mj_id2name(m_, mjOBJ_GEOM, g_id) : "") +
-                       "' raised by MuJoCo to 2 timestep = " + g(2 * o.timestep) + " (its refsafe rule)");
-      break;
-    }
-  }
-  if (condim_ >= 3 && o.cone == mjCONE_PYRAMIDAL) notes_.push_back("friction cone approximated by MuJoCo's pyramid (cone pyramidal)");
-  if (condim_ >= 3)
-    notes_.push_back("while slipping, MuJoCo's convex contact pushes the ball off the floor: the contact hops (intermittent normal force, many switch events)");
-  if (o.integrator != mjINT_RK4) notes_.push_back(std::string("integrator ") + integrator_name(o.integrator) + ": first order in the timestep");
-  if (!compiler_warning.empty()) notes_.push_back("mujoco compiler: " + compiler_warning);
-}
 
 SettingsList MujocoSimulator::settings() const {
-  if (user_) {
-    const mjOption& o = m_->opt;
-    auto n17 = [](const mjtNum* v, int n) {
-      std::string out = "[";
-      for (int i = 0; i < n; ++i) out += (i ? ", " : "") + num(v[i]);
-      return out + "]";
-    };
-    SettingsList list;
-    list.emplace_back("model", settings_.model);
-    list.emplace_back("body", top_.body);
-    list.emplace_back("keyframe", top_.keyframe_index >= 0 ? top_.keyframe : "(qpos0)");
-    list.emplace_back("start", keyframe_start_ ? "keyframe" : "scene");
-    list.emplace_back("timestep", num(o.timestep));
-    list.emplace_back("integrator", integrator_name(o.integrator));
-    list.emplace_back("cone", cone_name(o.cone));
-    list.emplace_back("impratio", num(o.impratio));
-    list.emplace_back("solver", solver_name(o.solver));
-    list.emplace_back("iterations", std::to_string(o.iterations));
-    list.emplace_back("tolerance", num(o.tolerance));
-    list.emplace_back("noslip_iterations", std::to_string(o.noslip_iterations));
-    list.emplace_back("noslip_tolerance", num(o.noslip_tolerance));
-    list.emplace_back("condim_used", std::to_string(top_.condim));
-    list.emplace_back("friction_used", n17(top_.contact_friction.data(), 5));
-    list.emplace_back("margin_used", num(top_.contact_margin));
-    list.emplace_back("solref_ball", n17(m_->geom_solref + mjNREF * ball_id_, mjNREF));
-    list.emplace_back("solimp_ball", n17(m_->geom_solimp + mjNIMP * ball_id_, mjNIMP));
-    list.emplace_back("solref_floor", n17(m_->geom_solref + mjNREF * floor_id_, mjNREF));
-    list.emplace_back("solimp_floor", n17(m_->geom_solimp + mjNIMP * floor_id_, mjNIMP));
-    return list;
-  }
+  if (user_) return user_model_settings(m_, top_, settings_.model, keyframe_start_);
   SettingsList list = list_settings(settings_);
   const Vec3 f = used_friction(settings_, scene());
   list.emplace_back("condim_used", std::to_string(condim_));
