@@ -18,10 +18,10 @@ namespace tippe {
 namespace {
 
 // Two principal moments are "equal" (an axisymmetric body) within 1e-9 of the largest. MuJoCo
-// diagonalises the compiled inertia by Jacobi rotations (mju_eig3); for a body that is
-// axisymmetric by construction the two transverse moments come out equal to rounding (the test
-// models: ~1e-16 relative), while a modelled asymmetry is orders larger (a ballast box 0.1 %
-// longer one way: ~1e-4). Within the tolerance A is their mean.
+// diagonalises the compiled inertia itself (body_inertia, body_iquat); for a body that is
+// axisymmetric by construction the two transverse moments come out equal to rounding (the three
+// test models: bit for bit), while a modelled asymmetry is orders larger (the tutorial top with
+// its ballast box 0.1 % longer one way: 5.8e-4). Within the tolerance A is their mean.
 constexpr double kInertiaTolerance = 1e-9;
 // A centre of mass, ball centre or stem off the symmetry axis by more than 1e-9 R is a modelled
 // offset, not rounding (positions compile to ~1e-16 R).
