@@ -153,6 +153,12 @@ std::vector<std::string> user_model_notes(const mjModel* m, const MjcfTopImport&
   if (tc > 0 && tc < 2 * o.timestep && !(o.disableflags & mjDSBL_REFSAFE))
     notes.push_back("contact solref timeconst " + g(tc) + " raised by MuJoCo to 2 timestep = " + g(2 * o.timestep) +
                    " (its refsafe rule)");
+  if (condim >= 4)
+    notes.push_back("drilling friction (condim " + std::to_string(condim) +
+                    "): MuJoCo bounds the tangential force and the drilling torque jointly, not each alone");
+  // MuJoCo raises every friction coefficient the contact uses to mjMINMU.
+  if ((condim >= 3 && !(top.contact_friction[0] >= mjMINMU)) || (condim >= 4 && !(top.contact_friction[2] >= mjMINMU)))
+    notes.push_back("a friction coefficient below MuJoCo's minimum mjMINMU = 1e-5 acts as that minimum, not as frictionless");
   if (condim >= 3 && o.cone == mjCONE_PYRAMIDAL) notes.push_back("friction cone approximated by MuJoCo's pyramid (cone pyramidal)");
   if (condim >= 3)
     notes.push_back("while slipping, MuJoCo's convex contact pushes the ball off the floor: the contact hops (intermittent normal force, many switch events)");
