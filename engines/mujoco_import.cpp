@@ -150,6 +150,15 @@ class Analyser {
              "' (its mass is not in body_mass: merge its geoms into the top's body)");
     if (m_->neq > 0) fail("the model has " + std::to_string(m_->neq) + " equality constraint(s): the reference has none");
     if (m_->nu > 0) fail(std::to_string(m_->nu) + " actuator(s) act on the top: the reference has no actuation");
+    if (m_->ntendon > 0) fail("the model has " + std::to_string(m_->ntendon) + " tendon(s): the reference has none");
+    // Joint properties of the free joint change the dynamics (armature adds inertia, damping and
+    // frictionloss add forces) and have no counterpart in the reference.
+    for (int v = m_->jnt_dofadr[joint_]; v < m_->jnt_dofadr[joint_] + 6; ++v) {
+      if (m_->dof_armature[v] != 0) fail("the free joint has armature " + g(m_->dof_armature[v]) + ": the reference has none");
+      if (m_->dof_damping[v] != 0) fail("the free joint has damping " + g(m_->dof_damping[v]) + ": the reference has none");
+      if (m_->dof_frictionloss[v] != 0)
+        fail("the free joint has frictionloss " + g(m_->dof_frictionloss[v]) + ": the reference has none");
+    }
     if (m_->opt.disableflags & (mjDSBL_CONSTRAINT | mjDSBL_CONTACT))
       fail("contacts are disabled (option flag): the top would fall through the floor");
     if (m_->opt.disableflags & mjDSBL_GRAVITY) fail("gravity is disabled (option flag): the reference needs g > 0");
