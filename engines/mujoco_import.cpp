@@ -380,6 +380,9 @@ class Analyser {
     for (int i = 0; i < 5; ++i) out.contact_solimp[i] = c.solimp[i];
     ContactSpec& s = out.contact;
     s.stem = out.stem;
+    if (c.dim >= 3 && c.friction[0] != c.friction[1])
+      fail("the ball-floor contact's sliding friction is anisotropic (" + g(c.friction[0]) + " and " + g(c.friction[1]) +
+           ", a <pair>'s): the reference's Coulomb friction is isotropic");
     switch (c.dim) {
       case 1: s.friction = FrictionLaw::None; break;
       case 3: s.friction = FrictionLaw::Coulomb, s.mu = c.friction[0]; break;

@@ -229,6 +229,38 @@ TEST(ImportMjcfContact, FrictionIsMujocosMixing) {
   EXPECT_TRUE(said) << "the cylinder's approximation must be a note";
 }
 
+// A geom of higher priority decides the contact alone (MuJoCo 2.2: its condim and friction), and
+// an explicit <pair> replaces the geoms' parameters altogether: both read from the contact
+// MuJoCo builds, never from the geoms' attributes.
+TEST(ImportMjcfContact, PriorityAndPairsAreMujocos) {
+  const fs::path dir = fs::temp_directory_path() / ("tippe_import_priority_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string ball = "<body name=\"top\" pos=\"0 0 .02\"><freejoint/><inertial pos=\"0 0 -.004\" mass=\".05\" "
+                           "diaginertia=\"1e-5 1e-5 1.1e-5\"/><geom name=\"ball\" type=\"sphere\" size=\".02\" condim=\"3\" "
+                           "friction=\"0.9 0.01 0\"/></body>";
+  const std::string priority = "<mujoco><worldbody><geom name=\"floor\" type=\"plane\" size=\"1 1 1\" priority=\"1\" "
+                               "condim=\"1\" friction=\"0.2 0 0\"/>" + ball + "</worldbody></mujoco>";
+  const std::string pair = "<mujoco><worldbody><geom name=\"floor\" type=\"plane\" size=\"1 1 1\"/>" + ball +
+                           "</worldbody><contact><pair geom1=\"floor\" geom2=\"ball\" condim=\"4\" "
+                           "friction=\"0.35 0.35 0.002 0 0\"/></contact></mujoco>";
+  std::ofstream(dir / "priority.xml") << priority;
+  std::ofstream(dir / "pair.xml") << pair;
+  const MjcfTopImport p = import_mjcf_top((dir / "priority.xml").string());
+  EXPECT_EQ(p.condim, 1);
+  EXPECT_EQ(p.contact.friction, FrictionLaw::None);
+  EXPECT_FALSE(p.stem);
+  const MjcfTopImport q = import_mjcf_top((dir / "pair.xml").string());
+  EXPECT_EQ(q.condim, 4);
+  EXPECT_EQ(q.contact.mu, 0.35);
+  EXPECT_EQ(q.contact.drilling, 0.002);
+  // A pair may make the friction anisotropic, which the reference's Coulomb law is not.
+  std::string anisotropic = pair;
+  anisotropic.replace(anisotropic.find("0.35 0.35"), 9, "0.35 0.5");
+  std::ofstream(dir / "anisotropic.xml") << anisotropic;
+  EXPECT_THROW(import_mjcf_top((dir / "anisotropic.xml").string()), MjcfImportError);
+  fs::remove_all(dir);
+}
+
 // Scenes over a user's model, in a directory of their own: the model beside the scene.
 class ImportMjcfScene : public ::testing::Test {
  protected:
