@@ -1,10 +1,10 @@
 // `tippe import-mjcf` and [engines.mujoco] model: a user's MJCF read as MuJoCo compiles it, and its MuJoCo run plain MuJoCo's bit for bit.
 //
-// Three models written for these tests (tests/data): MuJoCo's tutorial top as published (frame at
+// Four models written for these tests (tests/data): MuJoCo's tutorial top as published (frame at
 // the ball's centre, a flat-ended cylinder stem, a non-colliding ballast); a top whose frame is at
 // its centre of mass with the symmetry axis along the frame's x axis and a sliding, tilted,
 // turned keyframe; a top built from <default> classes and densities with a tilted keyframe that
-// is not the first. Each is imported by the real `tippe` binary; the scene it writes is then
+// is not the first; an eccentric ball without a stem and without a keyframe (qpos0, tilted). Each is imported by the real `tippe` binary; the scene it writes is then
 // checked against the compiled mjModel and run.
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
@@ -39,12 +39,14 @@ struct Model {
   const char* file;
   const char* body;
   const char* keyframe;  // "" : the importer's default (the first)
+  bool stem;
 };
 
 const Model kModels[] = {
-    {"mujoco_tutorial_top.xml", "top", ""},
-    {"import_com_frame_top.xml", "spinner", ""},
-    {"import_classes_top.xml", "toy", "tilted"},
+    {"mujoco_tutorial_top.xml", "top", "", true},
+    {"import_com_frame_top.xml", "spinner", "", true},
+    {"import_classes_top.xml", "toy", "tilted", true},
+    {"import_ball_top.xml", "ball", "", false},
 };
 
 // gtest shows a model by its file.
@@ -88,9 +90,14 @@ class ImportMjcf : public ::testing::TestWithParam<Model> {
     ASSERT_NE(m_, nullptr);
     body_ = mj_name2id(m_.get(), mjOBJ_BODY, GetParam().body);
     ASSERT_GE(body_, 0);
-    key_ = *GetParam().keyframe ? mj_name2id(m_.get(), mjOBJ_KEY, GetParam().keyframe) : 0;
+    key_ = *GetParam().keyframe ? mj_name2id(m_.get(), mjOBJ_KEY, GetParam().keyframe) : (m_->nkey > 0 ? 0 : -1);
   }
   void TearDown() override { fs::remove_all(dir_); }
+  // The start plain MuJoCo takes: the keyframe, or qpos0 at rest when the model has none.
+  void reset(mjData* d) const {
+    if (key_ >= 0) mj_resetDataKeyframe(m_.get(), d, key_);
+    else mj_resetData(m_.get(), d);
+  }
 
   fs::path dir_;
   std::string xml_, scene_;
@@ -105,8 +112,9 @@ TEST_P(ImportMjcf, MassPropertiesAreTheCompiledModels) {
   const Scene s = load_scene(scene_);
   const mjModel* m = m_.get();
   int ball = -1;
+  // The ball: the body's sphere that can touch the floor (contype 1 against the floor's conaffinity 1).
   for (int g = 0; g < m->ngeom; ++g)
-    if (m->geom_bodyid[g] == body_ && m->geom_type[g] == mjGEOM_SPHERE) ball = g;
+    if (m->geom_bodyid[g] == body_ && m->geom_type[g] == mjGEOM_SPHERE && m->geom_contype[g] != 0) ball = g;
   ASSERT_GE(ball, 0);
   const Vec3 G(m->body_ipos + 3 * body_), O(m->geom_pos + 3 * ball);
   const Vec3 axis = (O - G).normalized();  // every test model has G below the ball's centre
@@ -128,7 +136,7 @@ TEST_P(ImportMjcf, MassPropertiesAreTheCompiledModels) {
   EXPECT_PRED2(near, s.mass.inertia_transverse, transverse[1]);
   EXPECT_PRED2(near, s.body.sphere_radius, m->geom_size[3 * ball]);
   EXPECT_EQ(s.body.mass_model, MassModel::Given);
-  EXPECT_TRUE(s.contact.stem);
+  EXPECT_EQ(s.contact.stem, GetParam().stem);
 }
 
 // The scene's start is the keyframe's state of G, as MuJoCo itself computes it after
@@ -138,7 +146,7 @@ TEST_P(ImportMjcf, StartIsTheKeyframesStateOfG) {
   const Scene s = load_scene(scene_);
   const BodyState x = scene_initial_state(s);
   DataPtr d(mj_makeData(m_.get()));
-  mj_resetDataKeyframe(m_.get(), d.get(), key_);
+  reset(d.get());
   mj_forward(m_.get(), d.get());
   mjtNum vel[6];
   mj_objectVelocity(m_.get(), d.get(), mjOBJ_BODY, body_, vel, 0);
@@ -166,7 +174,7 @@ TEST_P(ImportMjcf, MujocoRunIsPlainMujocoBitForBit) {
   sim->advance_to(n * dt);
   ASSERT_EQ(sim->work().steps, n);
   DataPtr d(mj_makeData(m_.get()));
-  mj_resetDataKeyframe(m_.get(), d.get(), key_);
+  reset(d.get());
   for (int i = 0; i < n; ++i) mj_step(m_.get(), d.get());
   const std::vector<double> pose = mujoco_body_pose(*sim), qpos = mujoco_qpos(*sim), qvel = mujoco_qvel(*sim);
   for (int i = 0; i < 3; ++i) EXPECT_EQ(pose[i], d->xpos[3 * body_ + i]) << "xpos[" << i << "]";
@@ -175,8 +183,8 @@ TEST_P(ImportMjcf, MujocoRunIsPlainMujocoBitForBit) {
   for (int i = 0; i < m_->nv; ++i) EXPECT_EQ(qvel[i], d->qvel[i]) << "qvel[" << i << "]";
   // And the run moved: a test of a frozen state would pass as well.
   DataPtr d0(mj_makeData(m_.get()));
-  mj_resetDataKeyframe(m_.get(), d0.get(), key_);
-  EXPECT_NE(qvel[5], d0->qvel[5]);
+  reset(d0.get());
+  EXPECT_NE(qvel, std::vector<double>(d0->qvel, d0->qvel + m_->nv));
 }
 
 // The reference runs on the imported scene and starts with the keyframe's energy
@@ -187,7 +195,7 @@ TEST_P(ImportMjcf, ReferenceRunsOnTheImportedScene) {
   EXPECT_EQ(r.status, "ok") << r.status_detail;
   EXPECT_GT(r.samples, 10);
   DataPtr d(mj_makeData(m_.get()));
-  mj_resetDataKeyframe(m_.get(), d.get(), key_);
+  reset(d.get());
   mj_forward(m_.get(), d.get());
   mjtNum vel[6];
   mj_objectVelocity(m_.get(), d.get(), mjOBJ_BODY, body_, vel, 1);  // local: the principal frame
