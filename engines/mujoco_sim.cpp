@@ -3,6 +3,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -410,6 +411,11 @@ void MujocoSimulator::init_user_model(const Scene& scene) {
 SettingsList MujocoSimulator::settings() const {
   if (user_) return user_model_settings(m_, top_, settings_.model, keyframe_start_);
   SettingsList list = list_settings(settings_);
+  // The user-model keys are empty for the bench's own MJCF: left out, so that its records list
+  // exactly the settings in force.
+  list.erase(std::remove_if(list.begin(), list.end(),
+                            [](const auto& kv) { return kv.first == "model" || kv.first == "body" || kv.first == "keyframe"; }),
+             list.end());
   const Vec3 f = used_friction(settings_, scene());
   list.emplace_back("condim_used", std::to_string(condim_));
   list.emplace_back("friction_used", "[" + num(f.x()) + ", " + num(f.y()) + ", " + num(f.z()) + "]");
