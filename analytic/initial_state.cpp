@@ -7,7 +7,10 @@ BodyState scene_initial_state(const Scene& scene) {
   const BodyModel m = BodyModel::from_scene(scene);
   BodyState x;
   x.t = 0.0;
-  x.q_WB = Quat(Eigen::AngleAxisd(scene.initial.tilt, Vec3::UnitX()));
+  const InitialSpec& in = scene.initial;
+  x.q_WB = in.orientation_given
+               ? Quat(in.orientation[0], in.orientation[1], in.orientation[2], in.orientation[3]).normalized()
+               : Quat(Eigen::AngleAxisd(in.tilt, Vec3::UnitX()));
   // The body rests on whichever surface is lower at this tilt: the ball, or beyond the
   // switching tilt the stem tip (a top that starts already inverted).
   const Surface low = lower_surface(m, x.q_WB);
@@ -23,7 +26,7 @@ BodyState scene_initial_state(const Scene& scene) {
     x.w_B = Vec3(0, 0, scene.initial.spin);
   }
   const Vec3 w_W = x.q_WB * x.w_B;
-  x.p_WG = Vec3(0, 0, -R_C_W.z());
+  x.p_WG = Vec3(in.position[0], in.position[1], -R_C_W.z());
   if (scene.contact.friction == FrictionLaw::Rolling) {
     x.v_WG = R_C_W.cross(w_W);
   } else {

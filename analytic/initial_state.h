@@ -7,7 +7,8 @@
 
 namespace tippe {
 
-// Body tilted by initial.tilt about the lab x axis, resting on its lower surface (the ball, or
+// Body tilted by initial.tilt about the lab x axis (or turned by initial.orientation), G above
+// (initial.position[0], initial.position[1]), resting on its lower surface (the ball, or
 // beyond the switching tilt the stem tip; G above the origin at the height that puts it on the floor), angular velocity from spin, omega_B or
 // omega_along_contact, horizontal velocity of G as given (rolling: R_C x omega), vertical
 // velocity of G such that the ball's lowest point does not move vertically. With

@@ -46,6 +46,10 @@ struct ContactSpec {
 
 struct InitialSpec {
   double tilt = 0.0;                       // rad, rotation of the body about the lab x axis
+  // A general orientation instead of tilt (an imported keyframe): q_WB as w, x, y, z (unit).
+  bool orientation_given = false;
+  std::array<double, 4> orientation{1, 0, 0, 0};
+  std::array<double, 2> position{0, 0};    // horizontal position of G (x, y)
   bool omega_given = false;                // omega_B given instead of spin
   double spin = 0.0;                       // rad/s about the symmetry axis e_Z
   std::array<double, 3> omega_B{0, 0, 0};  // body-frame angular velocity when omega_given
@@ -86,6 +90,9 @@ struct Scene {
   InitialSpec initial;
   RunSpec run;
   EngineSettingTable engines;
+  // What a scene's maker approximated (e.g. `tippe import-mjcf`: "stem cylinder approximated by
+  // ..."): carried into every record and shown at the top of reports.
+  std::vector<std::string> notes;
 };
 
 }  // namespace tippe

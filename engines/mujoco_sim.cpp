@@ -1,8 +1,9 @@
-// MuJoCo 2.2.2 adapter: the scene as MJCF (one free body at G with a ball and a stem geom on a plane), stepped by the shared fixed-step loop.
+// MuJoCo 2.2.2 adapter: the scene as MJCF (one free body at G with a ball and a stem geom on a plane), or the user's own MJCF as written, stepped by the shared fixed-step loop.
 #include "mujoco_sim.h"
 
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -16,89 +17,13 @@
 
 #include "adapters.h"
 #include "fixed_step.h"
+#include "mujoco_settings.h"
+#include "mujoco_top.h"
+#include "mujoco_user_model.h"
 #include "settings.h"
 
 namespace tippe {
 namespace {
-
-// Every setting of the MuJoCo model that decides accuracy, read from [engines.mujoco].
-struct MujocoSettings {
-  // Small against the spin period (2 pi / 5 ~ 1.3 dimensionless, 0.04 s for the toy) and
-  // 20 steps per contact time constant (solref[0] = 0.002).
-  double timestep = 1e-4;
-  // "RK4": 4th order, so the explicit gyroscopic term w x I w of a fast spinning body causes
-  // no visible energy drift; "Euler" (MuJoCo's default, semi-implicit, 1st order) grows the
-  // nutation energy by O((w h)^2) per step; "implicit" (2.2: velocity-implicit with the RNE
-  // derivatives) is 1st order and numerically damped. RK4 costs 4 forward passes a step.
-  std::string integrator = "RK4";
-  // "elliptic" is the Coulomb cone itself (|F_t| <= mu F_n, isotropic); "pyramidal" is
-  // MuJoCo's default polyhedral approximation of it.
-  std::string cone = "elliptic";
-  // Friction-to-normal impedance ratio; MuJoCo's default: friction exactly as soft as the normal.
-  double impratio = 1.0;
-  // Newton: MuJoCo's default, converges quadratically; exact for a handful of constraint rows.
-  std::string solver = "Newton";
-  // A cap Newton does not reach at this tolerance for one body with at most 3 contacts.
-  int iterations = 100;
-  // Below MuJoCo's 1e-8 default so that solver error stays far below the compared quantities;
-  // it costs an iteration or two.
-  double tolerance = 1e-10;
-  // MuJoCo's default: no post-pass; the soft contact's own friction is the law being tested.
-  int noslip_iterations = 0;
-  // friction = rolling: the noslip pass removes the creep that soft friction allows, so the
-  // contact point really sticks.
-  int noslip_iterations_rolling = 10;
-  // Same order as the main tolerance (MuJoCo's default is 1e-6); used only when noslip runs.
-  double noslip_tolerance = 1e-10;
-  // [timeconst, dampratio]: MuJoCo's default 0.02 s leaves the toy top resting 2.6 % of R deep;
-  // 0.002 gives 2.6e-4 R there (4.5e-7 R for the dimensionless top), is critically damped, and
-  // keeps MuJoCo's stability rule timeconst >= 2 timestep for every timestep up to 1e-3.
-  std::vector<double> solref = {0.002, 1.0};
-  // [dmin, dmax, width, midpoint, power]: MuJoCo's default impedance profile.
-  std::vector<double> solimp = {0.9, 0.95, 0.001, 0.5, 2.0};
-  // 0: derived from the scene's friction law (1 none/viscous/gliding, 3 coulomb/rolling, 4 with
-  // drilling); 1, 3, 4 or 6 force that contact dimensionality (diagnostic).
-  int condim = 0;
-  // Friction coefficient that stands in for the rolling constraint (friction = rolling).
-  double rolling_mu = 1e3;
-  // Where the free body's frame (and so its joint) has its origin: a modelling choice, not
-  // physics, yet MuJoCo 2.2.2's answer depends on it (BENCHMARKS.md, "MuJoCo's body frame").
-  // MuJoCo applies its soft-constraint law to J qacc and never computes J-dot qvel
-  // (mj_fwdConstraint: efc_b = J qacc_smooth - aref); for a free joint that omitted term depends
-  // on the frame origin. "ball_centre" (the default): the origin at the ball's centre O, where the
-  // term is exactly zero for a sphere on a plane, so MuJoCo's contact law acts on the true gap and
-  // slip; it is also the frame of MuJoCo's tutorial top and of most hand-written models.
-  // "com": the origin at the centre of mass G (the bench's first choice), where the omitted
-  // term, d w3 |w_perp| in the friction rows (1.8 m/s^2 on the toy top), holds a false slip that
-  // turns Coulomb tops over ten times early.
-  std::string body_frame = "ball_centre";
-  // The stem's collision shape: a capsule from O to P (what a user models as the stem; the
-  // tutorial's is a cylinder), or the sphere of radius r at P alone (the reference's stem
-  // contact). Their lowest points agree at every tilt (the capsule's other end lies inside the
-  // ball); MuJoCo's capsule-plane routine may still add a second contact at that end within the
-  // margin, and the two shapes' contact frames differ, hence a choice to sweep.
-  std::string stem_shape = "capsule";
-
-  template <class V>
-  void visit(V& v) {
-    v("timestep", timestep, 1e-8, 0.1);
-    v("integrator", integrator, {"Euler", "RK4", "implicit"});
-    v("cone", cone, {"elliptic", "pyramidal"});
-    v("impratio", impratio, 1e-6, 1e6);
-    v("solver", solver, {"Newton", "CG", "PGS"});
-    v("iterations", iterations, 1, 1000000);
-    v("tolerance", tolerance, 0.0, 1.0);
-    v("noslip_iterations", noslip_iterations, 0, 1000000);
-    v("noslip_iterations_rolling", noslip_iterations_rolling, 0, 1000000);
-    v("noslip_tolerance", noslip_tolerance, 0.0, 1.0);
-    v("solref", solref, 2);
-    v("solimp", solimp, 5);
-    v("condim", condim, 0, 6);
-    v("rolling_mu", rolling_mu, 0.0, 1e15);
-    v("body_frame", body_frame, {"com", "ball_centre"});
-    v("stem_shape", stem_shape, {"capsule", "tip_sphere"});
-  }
-};
 
 [[noreturn]] void setting_error(const std::string& key, const std::string& why) {
   throw std::invalid_argument("engines.mujoco." + key + ": " + why);
@@ -132,6 +57,15 @@ void check_combination(const MujocoSettings& s) {
 MujocoSettings read_checked_settings(const Scene& scene) {
   MujocoSettings s = read_settings<MujocoSettings>("mujoco", scene);
   check_combination(s);
+  if (!s.model.empty()) {
+    // These shape the bench's own MJCF only; the user's model decides them.
+    for (const char* k : {"body_frame", "stem_shape", "condim", "rolling_mu", "noslip_iterations_rolling"})
+      if (mujoco_setting_given(scene, k))
+        setting_error(k, "not used with engines.mujoco.model (the model decides it: edit the model instead)");
+  } else {
+    for (const char* k : {"body", "keyframe"})
+      if (mujoco_setting_given(scene, k)) setting_error(k, "only used with engines.mujoco.model");
+  }
   return s;
 }
 
@@ -281,9 +215,7 @@ void install_warning_handler() {
 // Compiles MJCF text through a one-file VFS (no temporary file). Throws std::runtime_error
 // with MuJoCo's message; compiler warnings of a successful load go to `warning`.
 mjModel* compile_mjcf(const std::string& xml, std::string& warning) {
-  // mj_loadXML keeps process-wide "last model" state in 2.2: one load at a time.
-  static std::mutex mutex;
-  std::lock_guard<std::mutex> lock(mutex);
+  std::lock_guard<std::mutex> lock(mujoco_load_mutex());
   // mjVFS holds 2000 file names of 1000 bytes: too large for the stack.
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
@@ -334,6 +266,11 @@ class MujocoSimulator : public FixedStepSimulator {
   MujocoModelReadback readback() const;
   std::vector<double> qpos() const { return std::vector<double>(d_->qpos, d_->qpos + m_->nq); }
   std::vector<double> qvel() const { return std::vector<double>(d_->qvel, d_->qvel + m_->nv); }
+  std::vector<double> body_pose() const {
+    std::vector<double> out(d_->xpos + 3 * body_id_, d_->xpos + 3 * body_id_ + 3);
+    out.insert(out.end(), d_->xquat + 4 * body_id_, d_->xquat + 4 * body_id_ + 4);
+    return out;
+  }
 
  protected:
   void engine_step() override;
@@ -344,8 +281,10 @@ class MujocoSimulator : public FixedStepSimulator {
   long long engine_solver_iterations() const override { return solver_iterations_; }
 
  private:
-  ContactReport read_contacts() const;
+  ContactReport read_contacts() const { return read_contacts(d_); }
+  ContactReport read_contacts(const mjData* d) const;
   void make_notes(const std::string& compiler_warning);
+  void init_user_model(const Scene& scene);
 
   MujocoSettings settings_;
   int condim_ = 0;
@@ -357,6 +296,14 @@ class MujocoSimulator : public FixedStepSimulator {
   int body_id_ = -1, floor_id_ = -1, ball_id_ = -1, stem_id_ = -1;
   int qadr_ = 0, vadr_ = 0;
   double frame_z_ = 0.0;  // the body frame's origin F = G + frame_z_ e_Z
+  // The user's model: its body frame F is the model's own, turned by q_FB_ from the principal
+  // frame B, with G at p_FG_F_ in it.
+  bool user_ = false;
+  MjcfTopImport top_;
+  Quat q_FB_ = Quat::Identity();
+  Vec3 p_FG_F_ = Vec3::Zero();
+  bool keyframe_start_ = false;
+  MjTopIds ids_;
   ContactReport report_;
   std::string limit_;
   // MuJoCo met a NaN or |x| > mjMAXVAL in qpos, qvel or qacc and reset mjData to the model's
@@ -368,6 +315,10 @@ class MujocoSimulator : public FixedStepSimulator {
 MujocoSimulator::MujocoSimulator(const Scene& scene)
     : FixedStepSimulator(scene), settings_(read_checked_settings(scene)) {
   install_warning_handler();
+  if (!settings_.model.empty()) {
+    init_user_model(scene);
+    return;
+  }
   condim_ = used_condim(settings_, scene);
   frame_z_ = frame_origin_z(settings_, body());
   std::string compiler_warning;
@@ -395,8 +346,72 @@ MujocoSimulator::MujocoSimulator(const Scene& scene)
   start(settings_.timestep);
 }
 
+void MujocoSimulator::init_user_model(const Scene& scene) {
+  user_ = true;
+  std::string compiler_warning;
+  MjTopIds& ids = ids_;
+  check_user_model(scene, settings_, &mj_.model, &ids, &compiler_warning);
+  m_ = mj_.model;
+  const std::vector<std::string> overridden = apply_user_overrides(m_, scene, settings_, ids);
+  // Read again: the contact as the overrides leave it (solref, solimp), for the notes and settings.
+  top_ = analyse_mjcf_top(m_, settings_.model, settings_.body, settings_.keyframe);
+  d_ = mj_.data = mj_makeData(m_);
+  if (!d_) throw std::runtime_error("mujoco: mj_makeData failed");
+  body_id_ = ids.body;
+  floor_id_ = ids.floor;
+  ball_id_ = ids.ball;
+  stem_id_ = ids.stem;
+  qadr_ = ids.qadr;
+  vadr_ = ids.vadr;
+  q_FB_ = top_.q_FB;
+  p_FG_F_ = top_.p_FG_F;
+  condim_ = top_.condim;
+
+  const BodyState x0 = scene_initial_state(scene);
+  keyframe_start_ = same_start(x0, top_.start, body().R);
+  if (keyframe_start_) {
+    // The keyframe's own numbers: the run is plain MuJoCo's from it, bit for bit.
+    if (ids.key >= 0) mj_resetDataKeyframe(m_, d_, ids.key);
+    else mj_resetData(m_, d_);
+  } else {
+    // The scene's start (e.g. a --set initial.spin), converted to the model's frame F.
+    mj_resetData(m_, d_);
+    const Quat q_WF = (x0.q_WB * q_FB_.conjugate()).normalized();
+    const Vec3 r_FG_W = q_WF * p_FG_F_;
+    const Vec3 w_W = x0.q_WB * x0.w_B;
+    const Vec3 p_WF = x0.p_WG - r_FG_W, v_WF = x0.v_WG - w_W.cross(r_FG_W);
+    const Vec3 w_F = q_FB_ * x0.w_B;
+    mjtNum* q = d_->qpos + qadr_;
+    mjtNum* v = d_->qvel + vadr_;
+    q[0] = p_WF.x(), q[1] = p_WF.y(), q[2] = p_WF.z();
+    q[3] = q_WF.w(), q[4] = q_WF.x(), q[5] = q_WF.y(), q[6] = q_WF.z();
+    v[0] = v_WF.x(), v[1] = v_WF.y(), v[2] = v_WF.z();
+    v[3] = w_F.x(), v[4] = w_F.y(), v[5] = w_F.z();
+  }
+  d_->time = 0.0;
+  // Contacts at t = 0 for observe() before the first step, from a copy: an mj_forward on d_
+  // itself changes the first Euler step in its last bits (even with qacc_warmstart kept), and
+  // the steps must be plain MuJoCo's.
+  {
+    std::unique_ptr<mjData, void (*)(mjData*)> scratch(mj_makeData(m_), mj_deleteData);
+    if (!scratch) throw std::runtime_error("mujoco: mj_makeData failed");
+    mj_copyData(scratch.get(), m_, d_);
+    mj_forward(m_, scratch.get());
+    report_ = read_contacts(scratch.get());
+  }
+  notes_ = user_model_notes(m_, top_, settings_.model, keyframe_start_, overridden, compiler_warning);
+  start(m_->opt.timestep);
+}
+
+
 SettingsList MujocoSimulator::settings() const {
+  if (user_) return user_model_settings(m_, top_, settings_.model, keyframe_start_);
   SettingsList list = list_settings(settings_);
+  // The user-model keys are empty for the bench's own MJCF: left out, so that its records list
+  // exactly the settings in force.
+  list.erase(std::remove_if(list.begin(), list.end(),
+                            [](const auto& kv) { return kv.first == "model" || kv.first == "body" || kv.first == "keyframe"; }),
+             list.end());
   const Vec3 f = used_friction(settings_, scene());
   list.emplace_back("condim_used", std::to_string(condim_));
   list.emplace_back("friction_used", "[" + num(f.x()) + ", " + num(f.y()) + ", " + num(f.z()) + "]");
@@ -502,6 +517,17 @@ BodyState MujocoSimulator::engine_state() const {
   }
   const mjtNum* q = d_->qpos + qadr_;
   const mjtNum* v = d_->qvel + vadr_;
+  if (user_) {
+    // F is the model's frame: B = F turned by q_FB, G at p_FG_F in F.
+    const Quat q_WF = Quat(q[3], q[4], q[5], q[6]).normalized();
+    const Vec3 w_F(v[3], v[4], v[5]);
+    x.q_WB = q_WF * q_FB_;
+    x.w_B = q_FB_.conjugate() * w_F;
+    const Vec3 r_FG_W = q_WF * p_FG_F_;
+    x.p_WG = Vec3(q[0], q[1], q[2]) + r_FG_W;
+    x.v_WG = Vec3(v[0], v[1], v[2]) + (q_WF * w_F).cross(r_FG_W);
+    return x;
+  }
   x.q_WB = Quat(q[3], q[4], q[5], q[6]).normalized();
   // MuJoCo's free joint angular velocity is in the body (local) frame.
   x.w_B = Vec3(v[3], v[4], v[5]);
@@ -523,12 +549,12 @@ void MujocoSimulator::apply_force_W(const Vec3& f_W, const Vec3& p_W) {
   mj_applyFT(m_, d_, force, torque, point, body_id_, d_->qfrc_applied);
 }
 
-ContactReport MujocoSimulator::read_contacts() const {
+ContactReport MujocoSimulator::read_contacts(const mjData* data) const {
   ContactReport r;
   Vec3 moment = Vec3::Zero();
   double weight = 0.0;
-  for (int i = 0; i < d_->ncon; ++i) {
-    const mjContact& c = d_->contact[i];
+  for (int i = 0; i < data->ncon; ++i) {
+    const mjContact& c = data->contact[i];
     if (c.exclude != 0 || c.efc_address < 0) continue;
     const int g = c.geom1 == floor_id_ ? c.geom2 : (c.geom2 == floor_id_ ? c.geom1 : -1);
     if (g == ball_id_) r.ball = true;
@@ -536,7 +562,7 @@ ContactReport MujocoSimulator::read_contacts() const {
     else continue;
     mjtNum f[6];
     // In the contact frame, whose first axis is the normal (+z here): f[0] is the normal force.
-    mj_contactForce(m_, d_, i, f);
+    mj_contactForce(m_, data, i, f);
     r.normal_force += f[0];
     (g == ball_id_ ? r.normal_force_ball : r.normal_force_stem) += f[0];
     if (f[0] > 0) {
@@ -560,7 +586,7 @@ MujocoModelReadback MujocoSimulator::readback() const {
   r.inertia = Vec3(m_->body_inertia[3 * b], m_->body_inertia[3 * b + 1], m_->body_inertia[3 * b + 2]);
   r.iquat_B = Quat(m_->body_iquat[4 * b], m_->body_iquat[4 * b + 1], m_->body_iquat[4 * b + 2], m_->body_iquat[4 * b + 3]);
   r.timestep = m_->opt.timestep;
-  r.frame_origin_G = Vec3(0.0, 0.0, frame_z_);
+  r.frame_origin_G = user_ ? Vec3(q_FB_.conjugate() * (-p_FG_F_)) : Vec3(0.0, 0.0, frame_z_);
   r.nq = m_->nq;
   r.nv = m_->nv;
   return r;
@@ -579,14 +605,24 @@ MujocoModelReadback mujoco_model_readback(const Simulator& sim) {
 }
 std::vector<double> mujoco_qpos(const Simulator& sim) { return as_mujoco(sim, "mujoco_qpos").qpos(); }
 std::vector<double> mujoco_qvel(const Simulator& sim) { return as_mujoco(sim, "mujoco_qvel").qvel(); }
+std::vector<double> mujoco_body_pose(const Simulator& sim) { return as_mujoco(sim, "mujoco_body_pose").body_pose(); }
 
 std::unique_ptr<Simulator> make_mujoco_simulator(const Scene& scene) {
   return std::make_unique<MujocoSimulator>(scene);
 }
 
-void validate_mujoco_settings(const Scene& scene) { (void)read_checked_settings(scene); }
+void validate_mujoco_settings(const Scene& scene) {
+  const MujocoSettings s = read_checked_settings(scene);
+  if (!s.model.empty()) (void)check_user_model(scene, s, nullptr, nullptr, nullptr);
+}
 
-std::string mujoco_mjcf(const Scene& scene) { return build_mjcf(scene, read_checked_settings(scene)); }
+std::string mujoco_mjcf(const Scene& scene) {
+  const MujocoSettings s = read_checked_settings(scene);
+  if (!s.model.empty())
+    throw std::invalid_argument("engines.mujoco.model: the scene runs the user's model " + s.model +
+                                "; that file is its MuJoCo model (export-mjcf writes the bench's own)");
+  return build_mjcf(scene, s);
+}
 
 std::vector<std::string> mujoco_mjcf_missing(const Scene& scene) {
   std::vector<std::string> out;

@@ -28,5 +28,7 @@ MujocoModelReadback mujoco_model_readback(const Simulator& sim);
 // velocity in W, angular velocity in B).
 std::vector<double> mujoco_qpos(const Simulator& sim);
 std::vector<double> mujoco_qvel(const Simulator& sim);
+// mjData.xpos and xquat of the top's body as they are now (7 numbers).
+std::vector<double> mujoco_body_pose(const Simulator& sim);
 
 }  // namespace tippe

@@ -78,6 +78,14 @@ class SettingsReader {
     if (!ok) fail(key, "value \"" + *s + "\" is not one of: " + list);
     field = *s;
   }
+  // A free string (a path, a name): any value of the right type.
+  void operator()(const char* key, std::string& field) {
+    auto it = find(key);
+    if (!it) return;
+    auto s = std::get_if<std::string>(it);
+    if (!s) fail(key, "expected a string");
+    field = *s;
+  }
   void operator()(const char* key, std::vector<double>& field, size_t n) {
     auto it = find(key);
     if (!it) return;
@@ -121,6 +129,7 @@ class SettingsLister {
   void operator()(const char* key, int& field, int, int) { put(key, std::to_string(field)); }
   void operator()(const char* key, bool& field) { put(key, field ? "true" : "false"); }
   void operator()(const char* key, std::string& field, const std::vector<std::string>&) { put(key, field); }
+  void operator()(const char* key, std::string& field) { put(key, field); }
   void operator()(const char* key, std::vector<double>& field, size_t) {
     std::string s = "[";
     for (size_t i = 0; i < field.size(); ++i) s += (i ? ", " : "") + num(field[i]);

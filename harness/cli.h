@@ -92,6 +92,7 @@ std::string inversion_condition_text(double alpha, double ratio);
 
 Command setup_run(CLI::App& app);
 Command setup_export_mjcf(CLI::App& app);
+Command setup_import_mjcf(CLI::App& app);
 Command setup_info(CLI::App& app);
 Command setup_compare(CLI::App& app);  // and setup_report, in cli_compare.cpp
 Command setup_report(CLI::App& app);

@@ -30,6 +30,10 @@ struct CompareCliOptions {
 };
 
 void print_table_and_findings(const nlohmann::json& j) {
+  // The scene's own notes (an imported model's approximations) head the report.
+  if (j.contains("scene") && j.at("scene").is_object())
+    for (const auto& n : j.at("scene").value("notes", nlohmann::json::array()))
+      if (n.is_string()) std::printf("scene note: %s\n", n.get<std::string>().c_str());
   std::printf("%s", render_summary_table(j).c_str());
   for (const auto& f : report_findings(j)) std::printf("- %s\n", f.c_str());
 }

@@ -25,7 +25,7 @@ int export_mjcf(const ExportOptions& o) {
   try {
     text = mujoco_mjcf(scene);
   } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
+    throw UsageError(scene.source_file + ": " + e.what());
   }
   if (text.empty()) throw std::runtime_error("mujoco_mjcf produced no model");
   // A model that lacks part of the scene's physics is refused, or written with its gaps said in

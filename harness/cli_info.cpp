@@ -46,6 +46,7 @@ int info(const InfoOptions& o) {
 
   std::printf("scene              %s (%s, hash %s)\n", s.name.c_str(), s.source_file.c_str(), s.content_hash.c_str());
   if (!s.description.empty()) std::printf("description        %s\n", s.description.c_str());
+  for (const auto& n : s.notes) std::printf("note               %s\n", n.c_str());
   std::printf("geometry           R = %.10g, r = %.10g, l = %.10g, h = %.10g%s\n", R, s.body.stem_radius,
               s.body.stem_length, s.body.truncation_height, s.contact.stem ? "" : " (no stem contact)");
   if (s.body.mass_model == MassModel::Given)

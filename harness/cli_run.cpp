@@ -98,6 +98,8 @@ void print_summary(const RunRecord& r, const fs::path& dir) {
   std::printf("final          t = %.10g, tilt %.6g rad, %lld samples\n", r.final_time, r.final_tilt, r.samples);
   std::printf("work           %lld steps, %lld rhs evaluations, wall %.3f s, cpu %.3f s\n", r.work.steps,
               r.work.rhs_evaluations, r.work.wall_seconds, r.work.cpu_seconds);
+  for (const auto& n : r.scene_spec.value("notes", nlohmann::json::array()))
+    if (n.is_string()) std::printf("scene note     %s\n", n.get<std::string>().c_str());
   for (const auto& n : r.notes) std::printf("note           %s\n", n.c_str());
   std::printf("output         %s\n", dir.string().c_str());
 }

@@ -330,7 +330,7 @@ Metrics metrics_from_json(const json& j) {
 
 std::string physics_hash(const json& scene_json) {
   json physics = scene_json;
-  for (const char* key : {"engines", "name", "description", "source_file", "content_hash"}) physics.erase(key);
+  for (const char* key : {"engines", "name", "description", "source_file", "content_hash", "notes"}) physics.erase(key);
   // Whether the reference is checked is not physics: the same reference serves both.
   if (physics.contains("run") && physics["run"].is_object()) physics["run"].erase("self_check");
   // nlohmann::json keeps object keys sorted, so dump() is canonical.

@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "No progress on stderr (errors and warnings still go there)");
   app.fallthrough();
   // Adding a subcommand: write cli_NAME.cpp with setup_NAME, declare it in cli.h, list it here.
-  const cli::Setup commands[] = {cli::setup_run, cli::setup_export_mjcf, cli::setup_info,
+  const cli::Setup commands[] = {cli::setup_run, cli::setup_export_mjcf, cli::setup_import_mjcf, cli::setup_info,
                                   cli::setup_compare, cli::setup_report, cli::setup_sweep,
                                   cli::setup_gate};
   std::map<const CLI::App*, cli::Action> actions;

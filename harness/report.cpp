@@ -586,6 +586,13 @@ footer { margin-top: 2em; font-size: 0.85em; color: #555; border-top: 1px solid 
   const auto [check_headline, check_detail] = self_check_lines(c);
   if (!check_headline.empty()) h += "<p class=\"unconverged\"><strong>" + html_escape(check_headline) + "</strong></p>\n";
   if (!str(scene, "description").empty()) h += "<p>" + html_escape(str(scene, "description")) + "</p>\n";
+  // What the scene's maker approximated (an imported model's notes): first, before any number.
+  if (scene.contains("notes") && scene.at("notes").is_array() && !scene.at("notes").empty()) {
+    h += "<h2>Scene notes</h2>\n<ul>\n";
+    for (const auto& n : scene.at("notes"))
+      if (n.is_string()) h += "<li>" + html_escape(n.get<std::string>()) + "</li>\n";
+    h += "</ul>\n";
+  }
 
   h += "<h2>Scene</h2>\n<table class=\"params\">\n<tbody>\n";
   h += "<tr><th>gravity</th><td>" + html_escape(scalar_text(scene.value("gravity", json()))) + "</td></tr>\n";

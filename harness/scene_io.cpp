@@ -170,7 +170,7 @@ class Interpreter {
 
   Scene interpret(const toml::table& root, const std::string& default_name) {
     Scene s;
-    keys(root, "", {"name", "description", "gravity", "body", "contact", "initial", "run", "engines"});
+    keys(root, "", {"name", "description", "gravity", "notes", "body", "contact", "initial", "run", "engines"});
     const auto name = opt_string(root, "", "name");
     s.name = name.value_or(default_name);
     if (!is_valid_name(s.name))
@@ -180,6 +180,7 @@ class Interpreter {
     if (s.description.find_first_of("\r\n") != std::string::npos) fail("description", "must be one line");
     s.gravity = need_number(root, "", "gravity");
     if (!(s.gravity > 0)) out_of_range("gravity", s.gravity, "gravity > 0");
+    if (const toml::node* n = root.get("notes")) s.notes = read_notes(*n);
 
     // contact first: whether a stem exists decides which body keys are required.
     read_contact(need_table(root, "", "contact"), s.contact);
@@ -386,11 +387,41 @@ class Interpreter {
     return file_ + ": body" + (keyed ? "." : ": ") + what;
   }
 
+  // One line each: a note is printed as a line of `tippe run` and a list item of a report.
+  std::vector<std::string> read_notes(const toml::node& n) const {
+    const auto* a = n.as_array();
+    if (!a) fail("notes", "expected an array of strings, got " + toml_value_text(n));
+    std::vector<std::string> out;
+    for (size_t i = 0; i < a->size(); ++i) {
+      const std::string key = "notes[" + std::to_string(i) + "]";
+      const auto* str = a->get(i)->as_string();
+      if (!str) fail(key, "expected a string, got " + toml_value_text(*a->get(i)));
+      if (str->get().empty() || str->get().find_first_of("\r\n") != std::string::npos)
+        fail(key, "must be one non-empty line");
+      out.push_back(str->get());
+    }
+    return out;
+  }
+
   void read_initial(const toml::table& t, Scene& s) const {
-    keys(t, "initial", {"tilt", "spin", "omega", "velocity", "omega_along_contact", "height"});
+    keys(t, "initial", {"tilt", "orientation", "position", "spin", "omega", "velocity", "omega_along_contact", "height"});
     InitialSpec& in = s.initial;
-    in.tilt = need_number(t, "initial", "tilt");
-    if (!(in.tilt >= 0 && in.tilt <= kPi)) out_of_range("initial.tilt", in.tilt, "0 <= tilt <= pi = " + num(kPi) + " rad");
+    const auto orientation = opt_numbers(t, "initial", "orientation", 4);
+    if (orientation) {
+      if (t.contains("tilt")) fail("initial.orientation", "give either tilt or orientation, not both");
+      // A unit quaternion (w, x, y, z); 1e-9 admits one written with 10 significant digits and
+      // refuses one that is not meant as a rotation.
+      const double norm = std::sqrt((*orientation)[0] * (*orientation)[0] + (*orientation)[1] * (*orientation)[1] +
+                                    (*orientation)[2] * (*orientation)[2] + (*orientation)[3] * (*orientation)[3]);
+      if (!(std::abs(norm - 1.0) <= 1e-9))
+        fail("initial.orientation", "must be a unit quaternion [w, x, y, z], got norm " + num(norm));
+      in.orientation_given = true;
+      std::copy(orientation->begin(), orientation->end(), in.orientation.begin());
+    } else {
+      in.tilt = need_number(t, "initial", "tilt");
+      if (!(in.tilt >= 0 && in.tilt <= kPi)) out_of_range("initial.tilt", in.tilt, "0 <= tilt <= pi = " + num(kPi) + " rad");
+    }
+    if (const auto p = opt_numbers(t, "initial", "position", 2)) std::copy(p->begin(), p->end(), in.position.begin());
     const auto spin = opt_number(t, "initial", "spin");
     const auto omega = opt_numbers(t, "initial", "omega", 3);
     if (spin && omega) fail("initial.omega", "give either spin or omega, not both");
@@ -469,6 +500,7 @@ class Interpreter {
       auto& dst = s.engines[std::string(name.str())];
       for (auto&& [k, v] : *et) dst[std::string(k.str())] = to_setting(v, prefix + "." + std::string(k.str()));
     }
+    resolve_mujoco_model(s);
     try {
       validate_engine_settings(s);
     } catch (const std::invalid_argument& e) {
@@ -476,8 +508,39 @@ class Interpreter {
     }
   }
 
+  // engines.mujoco.model names the user's own MJCF, relative to the scene file: resolved here,
+  // read once (its bytes join the scene's content hash, so a changed model is a changed scene)
+  // and checked by validate_engine_settings (MuJoCo compiles it).
+  void resolve_mujoco_model(Scene& s) const {
+    auto engine = s.engines.find("mujoco");
+    if (engine == s.engines.end()) return;
+    auto it = engine->second.find("model");
+    if (it == engine->second.end()) return;
+    const auto* path = std::get_if<std::string>(&it->second);
+    if (!path) fail("engines.mujoco.model", "expected a string (a path to an MJCF file, relative to the scene file)");
+    if (path->empty()) fail("engines.mujoco.model", "is empty (expected a path to an MJCF file)");
+    std::filesystem::path p(*path);
+    if (p.is_relative()) p = std::filesystem::path(file_).parent_path() / p;
+    std::error_code ec;
+    if (std::filesystem::is_directory(p, ec)) fail("engines.mujoco.model", p.string() + ": is a directory");
+    try {
+      model_bytes_ = read_file_text(p.string(), kMaxInputFileBytes);
+    } catch (const std::runtime_error& e) {
+      fail("engines.mujoco.model", e.what());
+    }
+    it->second = p.lexically_normal().string();
+    has_model_ = true;
+  }
+
+ public:
+  bool has_model() const { return has_model_; }
+  const std::string& model_bytes() const { return model_bytes_; }
+
+ private:
   std::string file_;
   std::set<std::string> overridden_;
+  mutable std::string model_bytes_;
+  mutable bool has_model_ = false;
 };
 
 }  // namespace
@@ -538,7 +601,11 @@ Scene parse_scene_text(const std::string& text, const std::string& file_label,
 
   Scene s = interp.interpret(root, std::filesystem::path(file_label).stem().string());
   s.source_file = file_label;
-  s.content_hash = fnv1a64_hex(text, overrides);
+  // A scene that runs a user's MJCF hashes its bytes too: a changed model is a changed scene.
+  s.content_hash = interp.has_model() ? fnv1a64_hex(text + std::string(1, '\0') + "engines.mujoco.model" +
+                                                         std::string(1, '\0') + interp.model_bytes(),
+                                                     overrides)
+                                      : fnv1a64_hex(text, overrides);
   return s;
 }
 
@@ -554,7 +621,7 @@ nlohmann::json scene_to_json(const Scene& s) {
     for (const auto& [k, v] : table) t[k] = setting_to_json(v);
     engines[engine] = t;
   }
-  return json{
+  json out{
       {"name", s.name},
       {"description", s.description},
       {"source_file", s.source_file},
@@ -597,6 +664,11 @@ nlohmann::json scene_to_json(const Scene& s) {
         {"self_check", s.run.self_check}}},
       {"engines", engines},
   };
+  // Written only when used, so that the JSON (and the physics hash) of every other scene stays as it was.
+  if (s.initial.orientation_given) out["initial"]["orientation"] = s.initial.orientation;
+  if (s.initial.position[0] != 0.0 || s.initial.position[1] != 0.0) out["initial"]["position"] = s.initial.position;
+  if (!s.notes.empty()) out["notes"] = s.notes;
+  return out;
 }
 
 }  // namespace tippe

@@ -29,14 +29,16 @@ class SceneError : public std::runtime_error {
 // Rules beyond "every key known, every type right, every number finite" (integers are
 // accepted for floats, booleans are not numbers):
 //  - required: gravity (> 0), body.sphere_radius, body.truncation_height (0 < h <= R),
-//    contact.friction, initial.tilt ([0, pi]), one of initial.spin / initial.omega,
+//    contact.friction, initial.tilt ([0, pi]) or initial.orientation (a unit quaternion
+//    [w, x, y, z], |q| within 1e-9 of 1; not both), one of initial.spin / initial.omega,
 //    run.duration (> 0), run.sample_interval (> 0, <= duration, at most ~1.2e6 samples: a 1 GiB
 //    budget of trajectory bytes).
 //    body.stem_radius and body.stem_length are required unless contact.stem = false; when
 //    given they must be positive and, for every scene, pass geometry_problems(body, stem).
 //  - optional with defaults: name (file stem; letters, digits, '.', '_', '-'), description
 //    (one line), contact.drilling (0), contact.stem (true), contact.flight (false),
-//    initial.velocity (not given), initial.omega_along_contact (false), initial.height (0, >= 0),
+//    initial.velocity (not given), initial.position ([0, 0], G's x and y),
+//    initial.omega_along_contact (false), initial.height (0, >= 0), notes (one line each),
 //    run.rtol (1e-10, in [1e-15, 1e-2]), run.atol (1e-12, in (0, 1]).
 //  - mass: either density (> 0) and mass_model ("solid" | "seed"), both required, then
 //    compute_mass_properties(body); or all four of mass, com_offset, inertia_transverse,
@@ -51,10 +53,12 @@ class SceneError : public std::runtime_error {
 //    omega_along_contact takes its magnitude from spin and so cannot be combined with omega.
 //  - [engines.NAME] tables are copied into Scene::engines (bool, integer -> long long,
 //    float -> double, string, array of numbers -> vector<double>) and checked with
-//    validate_engine_settings.
+//    validate_engine_settings. engines.mujoco.model (a user's MJCF) is resolved relative to the
+//    scene file's directory and must be readable (at most kMaxInputFileBytes).
 // A path that is not valid UTF-8, and a --set value that is not valid UTF-8 and not a TOML value,
 // are rejected: records are JSON.
-// Scene::content_hash is FNV-1a 64 (16 hex digits) over the file's bytes and the overrides;
+// Scene::content_hash is FNV-1a 64 (16 hex digits) over the file's bytes, the overrides and the
+// bytes of engines.mujoco.model when given;
 // Scene::source_file is `path` as given.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
 
