@@ -199,6 +199,7 @@ struct ReferenceModel::Impl {
   std::vector<EvFn> fns;
   std::vector<double> g_start;
   std::array<Vec3, 2> ref_dir{Vec3::UnitX(), Vec3::UnitX()};
+  std::array<Vec3, 2> ref_coupled{Vec3::UnitX(), Vec3::UnitX()};  // coupled law: see ContactSlot::coupled_dir
   double drill_ref_sign = 1.0;
   bool pending = false;
   EvFn pending_fn{EvKind::Inversion, 0};
@@ -211,6 +212,15 @@ struct ReferenceModel::Impl {
   std::array<double, 2> flight_max_gap{0.0, 0.0};
   bool unresolved_noted = false;
   double v_scale = 0.0, slip_eps = 0.0;
+  // Coupled law: the generalised slip below which its direction is the slot's reference
+  // (ContactSlot::coupled_floor): 1e-3 of the stick threshold, far above the round-off of a
+  // slip zeroed at a restart and far below any slip the motion resolves.
+  double coupled_floor = 0.0;
+  // Coupled law, per slot: a contact that has just left stick starts from exactly zero slip
+  // (project() zeroes the drift of the stuck integration), so that it starts sliding in the
+  // direction the stuck forces give (coupled_slide_dir), not in that of the drift.
+  std::array<bool, 2> zero_coupled_slip{false, false};
+  std::array<bool, 2> solve_coupled_dir{false, false};  // ... and in the consistent direction (restart)
   double dt_hint = 0.0;
   std::string failure_hint;  // appended to a "non-finite state" failure: what to try instead
   long long events_in_burst = 0;
@@ -254,8 +264,11 @@ struct ReferenceModel::Impl {
         fns.push_back({EvKind::GrazePinch, s});
       } else if (slot.active) {
         fns.push_back({EvKind::NormalForce, s});
+        // Under the coupled law, SlipReversal and ConeExit watch the generalised slip and the
+        // ellipse (the law sticks and slips as a whole); there are no drilling events of its own.
         if (c.friction == FrictionLaw::Coulomb) fns.push_back({slot.stick ? EvKind::ConeExit : EvKind::SlipReversal, s});
-        if (c.drilling > 0) fns.push_back({slot.drill_stick ? EvKind::DrillConeExit : EvKind::DrillReversal, s});
+        if (c.drilling > 0 && !dyn.coupled())
+          fns.push_back({slot.drill_stick ? EvKind::DrillConeExit : EvKind::DrillReversal, s});
       } else {
         fns.push_back({EvKind::Touchdown, s});
       }
@@ -272,7 +285,24 @@ struct ReferenceModel::Impl {
     }
     const double wz = (unpack(y, 0).q_WB.normalized() * unpack(y, 0).w_B).z();
     drill_ref_sign = wz >= 0 ? 1.0 : -1.0;
+    if (dyn.coupled())
+      for (int s = 0; s < 2; ++s) {
+        const Vec3 u = coupled_slip(f, wz, s);
+        const double S = u.norm();
+        Vec3 dir = S > mode.slot[s].coupled_floor ? Vec3(u / S) : mode.slot[s].coupled_dir;
+        if (dir.dot(mode.slot[s].coupled_dir) < 0) dir = -dir;
+        mode.slot[s].coupled_dir = ref_coupled[s] = dir;
+      }
   }
+
+  // The coupled law's generalised slip (mu v_x, mu v_y, mu_d w_z) from the slip the forces
+  // report (ContactDynamics::coupled_slip, without normalizing the state again).
+  Vec3 coupled_slip(const ContactForces& f, double w_z, int s) const {
+    const ContactSpec& c = dyn.contact();
+    return Vec3(c.mu * f.slip_W[s].x(), c.mu * f.slip_W[s].y(), c.drilling * w_z);
+  }
+  // Its size in velocity units, |(v, (mu_d / mu) w_z)|, for the stick threshold slip_eps.
+  double coupled_speed(const Vec3& u) const { return u.norm() / dyn.contact().mu; }
 
   double g(const EvFn& fn, const StateVector& y, const ContactForces* f) {
     const BodyState x = unpack(y, 0.0);
@@ -313,8 +343,12 @@ struct ReferenceModel::Impl {
       // source_dimensionless a0 is then ~-3e-6 g and crosses 0 ~5e-5 time units later: the
       // lift it makes early moves the gap by ~1e-15 R, far below any resolution.
       case EvKind::GrazePinch: return cf.graze_loaded_accel[s] - cf.graze_lifted_accel[s] - 1e-5 * dyn.body().g;
-      case EvKind::SlipReversal: return cf.slip_W[s].dot(ref_dir[s]);
-      case EvKind::ConeExit: return c.mu * cf.normal[s] - std::hypot(cf.force_W[s].x(), cf.force_W[s].y());
+      case EvKind::SlipReversal:
+        if (dyn.coupled()) return coupled_slip(cf, (q * x.w_B).z(), s).dot(ref_coupled[s]);
+        return cf.slip_W[s].dot(ref_dir[s]);
+      case EvKind::ConeExit:
+        if (dyn.coupled()) return cf.normal[s] - dyn.coupled_demand(cf, s);
+        return c.mu * cf.normal[s] - std::hypot(cf.force_W[s].x(), cf.force_W[s].y());
       case EvKind::DrillConeExit: return c.drilling * cf.normal[s] - std::abs(cf.drill_torque[s]);
       default: return 0.0;
     }
@@ -428,6 +462,10 @@ struct ReferenceModel::Impl {
     double dt = dt_hint > 0 ? dt_hint : 1e-4;
     if (first_dt > 0) dt = std::min(dt, first_dt);
     stepper.initialize(y, t, dt);
+    for (int k = 0; k < 2; ++k)
+      if (solve_coupled_dir[k] && mode.slot[k].active && !mode.slot[k].stick)
+        mode.slot[k].coupled_dir = consistent_coupled_dir(y, k, mode.slot[k].coupled_dir);
+    solve_coupled_dir = {false, false};
     build_event_functions();
     refresh_references(y);
     g_start = g_all(y);
@@ -555,6 +593,75 @@ struct ReferenceModel::Impl {
     refresh_references(y1);
   }
 
+  // Coupled law: the direction of the generalised slip in which a contact whose sticking
+  // forces (F_t, tau) have left the ellipse starts to slide: the slip that makes the sliding
+  // law's force point as the sticking one does, u ~ -(F_t / mu, tau / mu_d) (the normal of
+  // the ellipse at (F_t, tau) scaled back to its boundary).
+  Vec3 coupled_slide_dir(const ContactForces& f, int s) const {
+    const ContactSpec& c = dyn.contact();
+    const Vec3 u(-f.force_W[s].x() / c.mu, -f.force_W[s].y() / c.mu, -f.drill_torque[s] / c.drilling);
+    return u.norm() > 0 ? Vec3(u.normalized()) : ref_coupled[s];
+  }
+
+  // Coupled law: rate of change of slot s's generalised slip (mu v, mu_d w_z) at a state where
+  // it is zero, sliding in the direction u (the acceleration of the material point at C,
+  // a_G + dw/dt x R_C + w x (w x r_GO), as in the constraint rows).
+  Vec3 coupled_slip_rate(const StateVector& y, int s, const Vec3& u) {
+    ContactMode m = mode;
+    m.slot[s].stick = m.slot[s].drill_stick = false;
+    m.slot[s].coupled_dir = u;
+    m.slot[s].coupled_floor = std::numeric_limits<double>::infinity();
+    StateVector dy;
+    ++owner.rhs_evals_;
+    dyn.evaluate(y, m, &dy);
+    const BodyState x = unpack(y, 0);
+    const Quat q = x.q_WB.normalized();
+    const Vec3 w_W = q * x.w_B, wdot_W = q * Vec3(dy[10], dy[11], dy[12]);
+    const ContactGeometry geo = dyn.geometry(x, s);
+    const Vec3 a = Vec3(dy[3], dy[4], dy[5]) + wdot_W.cross(geo.r_GC_W) + w_W.cross(w_W.cross(geo.r_GO_W));
+    const ContactSpec& c = dyn.contact();
+    return Vec3(c.mu * a.x(), c.mu * a.y(), c.drilling * wdot_W.z());
+  }
+
+  // Coupled law: the direction in which a contact starts to slide from zero slip is the one
+  // the slip then grows along: u with rate(u) = alpha u, alpha > 0 (Filippov's consistent
+  // direction). coupled_slide_dir() gives it exactly only in the limit of a frictionless
+  // coupling to the normal force; the stuck forces' direction and the slip's grow apart
+  // with the anisotropy of the generalised mobility (translation ~1/M, spin ~1/C, scaled by
+  // mu and mu_d), and a start off the consistent direction makes the direction turn at a rate
+  // ~|rate| / S as the slip S grows from 0: a stiff start. Newton's method on the unit sphere
+  // (two tangent coordinates, Jacobian by differences) from the stuck forces' direction; a
+  // start it cannot improve on is kept.
+  Vec3 consistent_coupled_dir(const StateVector& y, int s, Vec3 u) {
+    u.normalize();
+    auto residual = [&](const Vec3& d, const Vec3& e1, const Vec3& e2, double* along) {
+      const Vec3 r = coupled_slip_rate(y, s, d);
+      const double n = r.norm();
+      if (along) *along = n > 0 ? r.dot(d) / n : 0.0;
+      return n > 0 ? Eigen::Vector2d(r.dot(e1) / n, r.dot(e2) / n) : Eigen::Vector2d(0, 0);
+    };
+    for (int it = 0; it < 12; ++it) {
+      const Vec3 e1 = u.unitOrthogonal(), e2 = u.cross(e1);
+      double along = 0.0;
+      const Eigen::Vector2d F = residual(u, e1, e2, &along);
+      if (F.norm() < 1e-13 && along > 0) break;
+      constexpr double h = 1e-7;
+      Eigen::Matrix2d J;
+      J.col(0) = (residual((u + h * e1).normalized(), e1, e2, nullptr) - F) / h;
+      J.col(1) = (residual((u + h * e2).normalized(), e1, e2, nullptr) - F) / h;
+      const Eigen::Vector2d step = J.fullPivLu().solve(-F);
+      if (!step.allFinite()) break;
+      const double len = step.norm();
+      const Eigen::Vector2d st = len > 0.5 ? Eigen::Vector2d(step * (0.5 / len)) : step;  // at most ~30 deg a step
+      const Vec3 next = (u + st.x() * e1 + st.y() * e2).normalized();
+      double along_next = 0.0;
+      (void)residual(next, e1, e2, &along_next);
+      if (!(along_next > 0)) break;  // the slip would not grow along it: not a start
+      u = next;
+    }
+    return u;
+  }
+
   ContactMode settle(const StateVector& y, std::array<bool, 2> candidates, const ContactMode& prev) {
     const ContactSpec& c = dyn.contact();
     ContactMode m;
@@ -565,8 +672,14 @@ struct ReferenceModel::Impl {
       slot.slip_dir_W = prev.slot[s].slip_dir_W;
       slot.drill_stick = prev.slot[s].active && prev.slot[s].drill_stick;
       slot.graze = false;
+      slot.coupled_dir = prev.slot[s].coupled_dir;
+      slot.coupled_floor = coupled_floor;
       if (c.friction == FrictionLaw::Rolling) slot.stick = true;
-      if (c.friction == FrictionLaw::Coulomb) {
+      if (c.friction == FrictionLaw::Coulomb && dyn.coupled()) {
+        const Vec3 u = dyn.coupled_slip(x, s);
+        slot.stick = slot.drill_stick = coupled_speed(u) <= slip_eps;
+        if (!slot.stick) slot.coupled_dir = u.normalized();
+      } else if (c.friction == FrictionLaw::Coulomb) {
         Vec3 v = dyn.contact_velocity(x, s);
         v.z() = 0;
         slot.stick = v.norm() <= slip_eps;
@@ -590,6 +703,14 @@ struct ReferenceModel::Impl {
       for (int s = 0; s < 2; ++s) {
         ContactSlot& slot = m.slot[s];
         if (!slot.active) continue;
+        if (dyn.coupled()) {
+          if (slot.stick && dyn.coupled_demand(f, s) > f.normal[s]) {
+            slot.stick = slot.drill_stick = false;
+            slot.coupled_dir = coupled_slide_dir(f, s);
+            changed = true;
+          }
+          continue;
+        }
         if (c.friction == FrictionLaw::Coulomb && slot.stick) {
           const Vec3 ft(f.force_W[s].x(), f.force_W[s].y(), 0.0);
           if (ft.norm() > c.mu * f.normal[s]) {
@@ -630,6 +751,14 @@ struct ReferenceModel::Impl {
         x.w_B = x.q_WB.conjugate() * w_W;
       }
     }
+    if (dyn.coupled())
+      for (int k = 0; k < 2; ++k)
+        if (mode.slot[k].active && (mode.slot[k].stick || zero_coupled_slip[k])) {
+          // The coupled law sticks as a whole: the spin about the vertical is held at zero too.
+          Vec3 w_W = x.q_WB * x.w_B;
+          w_W.z() = 0.0;
+          x.w_B = x.q_WB.conjugate() * w_W;
+        }
     if (s >= 0) {
       const ContactGeometry geo = dyn.geometry(x, s);
       const Vec3 w_W = x.q_WB * x.w_B;
@@ -645,7 +774,7 @@ struct ReferenceModel::Impl {
         x.w_B = held.w_B;
       } else {
         x.v_WG.z() = -w_W.cross(geo.r_GO_W).z();
-        if (mode.slot[s].stick) {
+        if (mode.slot[s].stick || (dyn.coupled() && zero_coupled_slip[s])) {
           Vec3 slip = dyn.contact_velocity(x, s);
           slip.z() = 0;
           x.v_WG -= slip;
@@ -654,6 +783,8 @@ struct ReferenceModel::Impl {
     } else if (positioned) {
       *positioned = pack(x);
     }
+    for (int k = 0; k < 2; ++k) solve_coupled_dir[k] = solve_coupled_dir[k] || zero_coupled_slip[k];
+    zero_coupled_slip = {false, false};
     return pack(x);
   }
 
@@ -738,6 +869,25 @@ struct ReferenceModel::Impl {
         break;
       }
       case EvKind::SlipReversal: {
+        if (dyn.coupled()) {
+          // The generalised slip (v, w_z) passes through (or near) zero: stick as a whole if
+          // the sticking forces lie in the ellipse, else slide on in the direction they give.
+          if (coupled_speed(dyn.coupled_slip(x, s)) <= slip_eps) {
+            ContactMode trial = next;
+            trial.slot[s].stick = trial.slot[s].drill_stick = true;
+            const ContactForces f = forces_at(y, trial);
+            const double demand = dyn.coupled_demand(f, s);
+            if (demand <= f.normal[s]) {
+              next = trial;
+              owner.events_.push_back({"stick", te, std::string("slip and spin about the vertical vanish on the ") + slot_name(s) +
+                                                        " (coupled law)", demand / f.normal[s]});
+            } else {
+              next.slot[s].coupled_dir = coupled_slide_dir(f, s);
+              zero_coupled_slip[s] = true;
+            }
+          }
+          break;
+        }
         Vec3 v = dyn.contact_velocity(x, s);
         v.z() = 0;
         if (v.norm() <= slip_eps) {
@@ -756,6 +906,13 @@ struct ReferenceModel::Impl {
       }
       case EvKind::ConeExit: {
         const ContactForces f = forces_at(y, mode);
+        if (dyn.coupled()) {
+          next.slot[s].stick = next.slot[s].drill_stick = false;
+          next.slot[s].coupled_dir = coupled_slide_dir(f, s);
+          zero_coupled_slip[s] = true;
+          owner.events_.push_back({"slip", te, std::string("friction and drilling torque leave the ellipse on the ") + slot_name(s) + " (coupled law)", 0.0});
+          break;
+        }
         const Vec3 ft(f.force_W[s].x(), f.force_W[s].y(), 0.0);
         next.slot[s].stick = false;
         next.slot[s].slip_dir_W = ft.norm() > 0 ? Vec3(-ft.normalized()) : ref_dir[s];
@@ -902,6 +1059,7 @@ ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene
   const double v_scale = std::max({x0.v_WG.norm(), x0.w_B.norm() * body_.R, std::sqrt(body_.g * body_.R)});
   impl_->v_scale = v_scale;
   impl_->slip_eps = std::max(1e-7, 10.0 * scene.run.rtol) * v_scale;
+  impl_->coupled_floor = 1e-3 * impl_->slip_eps * scene.contact.mu;
   const double period = std::min(2 * M_PI / std::max(x0.w_B.norm(), 1e-9), std::sqrt(body_.R / body_.g));
   impl_->dt_hint = 1e-3 * period;
   if (scene.contact.friction == FrictionLaw::Viscous && scene.contact.k > 0 && scene.run.method != "rosenbrock4") {

@@ -40,8 +40,8 @@ int info(const InfoOptions& o) {
   std::printf("A/C                %.10g\n", ratio);
   std::printf("can invert         %s (1 - alpha = %.6g < A/C = %.6g < 1 + alpha = %.6g)\n",
               inversion_possible(m, R) ? "yes" : "no", 1 - alpha, ratio, 1 + alpha);
-  std::printf("contact            %s, mu = %g, k = %g, drilling = %g, flight %s\n", to_string(s.contact.friction),
-              s.contact.mu, s.contact.k, s.contact.drilling, s.contact.flight ? "on" : "off");
+  std::printf("contact            %s, mu = %g, k = %g, drilling = %g (%s), flight %s\n", to_string(s.contact.friction),
+              s.contact.mu, s.contact.k, s.contact.drilling, to_string(s.contact.drilling_law), s.contact.flight ? "on" : "off");
   std::printf("run                duration %g, sample interval %g, rtol %g, atol %g\n", s.run.duration,
               s.run.sample_interval, s.run.rtol, s.run.atol);
 
