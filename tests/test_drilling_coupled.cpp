@@ -9,6 +9,7 @@
 
 #include "../analytic/reference_model.h"
 #include "scene_io.h"
+#include "simulator.h"
 
 namespace tippe {
 namespace {
@@ -309,6 +310,38 @@ TEST(DrillingCoupled, TwinSettlesAtAnIntermediateTilt) {
   EXPECT_GT(lo, M_PI / 2);
   EXPECT_LT(hi, M_PI);
   EXPECT_FALSE(first_event(m.events(), "stem_contact").has_value());
+}
+
+// Each engine says in its record what it does with the coupled law: MuJoCo's elliptic cone
+// (condim 4) is the ellipse itself; its pyramid bounds force and torque by a polytope; Bullet
+// and ODE bound them each on its own, so their run is the decoupled law and says so. The note
+// is the contract: an engine run of a coupled scene never passes for the coupled law silently.
+TEST(DrillingCoupled, EnginesStateWhatTheyDoWithTheCoupledLaw) {
+  const Scene s = shipped("leine_glocker_coupled");
+  auto has_note = [](const std::vector<std::string>& notes, const std::string& start) {
+    return std::any_of(notes.begin(), notes.end(), [&](const std::string& n) { return n.rfind(start, 0) == 0; });
+  };
+  const std::vector<std::string> engines = available_engines();
+  for (const std::string& engine : engines) {
+    if (engine == "analytic") continue;
+    const auto sim = make_simulator(engine, s);
+    const std::vector<std::string> notes = sim->notes();
+    if (engine == "mujoco") {
+      EXPECT_TRUE(has_note(notes, "drilling coupled natively")) << engine;
+      EXPECT_FALSE(has_note(notes, "drilling decoupled")) << engine;
+      Scene pyr = s;
+      pyr.engines["mujoco"]["cone"] = std::string("pyramidal");
+      EXPECT_TRUE(has_note(make_simulator(engine, pyr)->notes(), "drilling coupled by a polytope")) << engine;
+    } else if (engine == "bullet" || engine == "ode") {
+      EXPECT_TRUE(has_note(notes, "drilling decoupled")) << engine;
+    }
+    // The same engine on the decoupled scene says nothing of the coupled law.
+    Scene dec = s;
+    dec.contact.drilling_law = DrillingLaw::Decoupled;
+    const std::vector<std::string> dec_notes = make_simulator(engine, dec)->notes();
+    EXPECT_FALSE(has_note(dec_notes, "drilling decoupled")) << engine;
+    EXPECT_FALSE(has_note(dec_notes, "drilling coupled natively")) << engine;
+  }
 }
 
 }  // namespace
