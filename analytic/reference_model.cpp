@@ -220,7 +220,7 @@ struct ReferenceModel::Impl {
   // (project() zeroes the drift of the stuck integration), so that it starts sliding in the
   // direction the stuck forces give (coupled_slide_dir), not in that of the drift.
   std::array<bool, 2> zero_coupled_slip{false, false};
-  std::array<bool, 2> solve_coupled_dir{false, false};  // ... and in the consistent direction (restart)
+  std::array<bool, 2> fresh_coupled_slip{false, false};  // ... and its SlipReversal starts positive (restart)
   double dt_hint = 0.0;
   std::string failure_hint;  // appended to a "non-finite state" failure: what to try instead
   long long events_in_burst = 0;
@@ -462,13 +462,17 @@ struct ReferenceModel::Impl {
     double dt = dt_hint > 0 ? dt_hint : 1e-4;
     if (first_dt > 0) dt = std::min(dt, first_dt);
     stepper.initialize(y, t, dt);
-    for (int k = 0; k < 2; ++k)
-      if (solve_coupled_dir[k] && mode.slot[k].active && !mode.slot[k].stick)
-        mode.slot[k].coupled_dir = consistent_coupled_dir(y, k, mode.slot[k].coupled_dir);
-    solve_coupled_dir = {false, false};
     build_event_functions();
     refresh_references(y);
     g_start = g_all(y);
+    // A coupled contact that starts to slide from zero slip starts on the positive side of its
+    // SlipReversal function (0 there): the continuation's flip of the direction makes a slip
+    // that grows against the reference a self-consistent motion in which the force drives the
+    // slip; a crossing from exactly 0 would not be bracketed, so it is counted as one.
+    for (size_t i = 0; i < fns.size(); ++i)
+      if (fns[i].kind == EvKind::SlipReversal && dyn.coupled() && fresh_coupled_slip[fns[i].slot] && !(g_start[i] > 0))
+        g_start[i] = std::numeric_limits<double>::denorm_min();
+    fresh_coupled_slip = {false, false};
     track_graze(graze_last);
     pending = false;
     ledger_t = t;
@@ -603,65 +607,6 @@ struct ReferenceModel::Impl {
     return u.norm() > 0 ? Vec3(u.normalized()) : ref_coupled[s];
   }
 
-  // Coupled law: rate of change of slot s's generalised slip (mu v, mu_d w_z) at a state where
-  // it is zero, sliding in the direction u (the acceleration of the material point at C,
-  // a_G + dw/dt x R_C + w x (w x r_GO), as in the constraint rows).
-  Vec3 coupled_slip_rate(const StateVector& y, int s, const Vec3& u) {
-    ContactMode m = mode;
-    m.slot[s].stick = m.slot[s].drill_stick = false;
-    m.slot[s].coupled_dir = u;
-    m.slot[s].coupled_floor = std::numeric_limits<double>::infinity();
-    StateVector dy;
-    ++owner.rhs_evals_;
-    dyn.evaluate(y, m, &dy);
-    const BodyState x = unpack(y, 0);
-    const Quat q = x.q_WB.normalized();
-    const Vec3 w_W = q * x.w_B, wdot_W = q * Vec3(dy[10], dy[11], dy[12]);
-    const ContactGeometry geo = dyn.geometry(x, s);
-    const Vec3 a = Vec3(dy[3], dy[4], dy[5]) + wdot_W.cross(geo.r_GC_W) + w_W.cross(w_W.cross(geo.r_GO_W));
-    const ContactSpec& c = dyn.contact();
-    return Vec3(c.mu * a.x(), c.mu * a.y(), c.drilling * wdot_W.z());
-  }
-
-  // Coupled law: the direction in which a contact starts to slide from zero slip is the one
-  // the slip then grows along: u with rate(u) = alpha u, alpha > 0 (Filippov's consistent
-  // direction). coupled_slide_dir() gives it exactly only in the limit of a frictionless
-  // coupling to the normal force; the stuck forces' direction and the slip's grow apart
-  // with the anisotropy of the generalised mobility (translation ~1/M, spin ~1/C, scaled by
-  // mu and mu_d), and a start off the consistent direction makes the direction turn at a rate
-  // ~|rate| / S as the slip S grows from 0: a stiff start. Newton's method on the unit sphere
-  // (two tangent coordinates, Jacobian by differences) from the stuck forces' direction; a
-  // start it cannot improve on is kept.
-  Vec3 consistent_coupled_dir(const StateVector& y, int s, Vec3 u) {
-    u.normalize();
-    auto residual = [&](const Vec3& d, const Vec3& e1, const Vec3& e2, double* along) {
-      const Vec3 r = coupled_slip_rate(y, s, d);
-      const double n = r.norm();
-      if (along) *along = n > 0 ? r.dot(d) / n : 0.0;
-      return n > 0 ? Eigen::Vector2d(r.dot(e1) / n, r.dot(e2) / n) : Eigen::Vector2d(0, 0);
-    };
-    for (int it = 0; it < 12; ++it) {
-      const Vec3 e1 = u.unitOrthogonal(), e2 = u.cross(e1);
-      double along = 0.0;
-      const Eigen::Vector2d F = residual(u, e1, e2, &along);
-      if (F.norm() < 1e-13 && along > 0) break;
-      constexpr double h = 1e-7;
-      Eigen::Matrix2d J;
-      J.col(0) = (residual((u + h * e1).normalized(), e1, e2, nullptr) - F) / h;
-      J.col(1) = (residual((u + h * e2).normalized(), e1, e2, nullptr) - F) / h;
-      const Eigen::Vector2d step = J.fullPivLu().solve(-F);
-      if (!step.allFinite()) break;
-      const double len = step.norm();
-      const Eigen::Vector2d st = len > 0.5 ? Eigen::Vector2d(step * (0.5 / len)) : step;  // at most ~30 deg a step
-      const Vec3 next = (u + st.x() * e1 + st.y() * e2).normalized();
-      double along_next = 0.0;
-      (void)residual(next, e1, e2, &along_next);
-      if (!(along_next > 0)) break;  // the slip would not grow along it: not a start
-      u = next;
-    }
-    return u;
-  }
-
   ContactMode settle(const StateVector& y, std::array<bool, 2> candidates, const ContactMode& prev) {
     const ContactSpec& c = dyn.contact();
     ContactMode m;
@@ -783,7 +728,7 @@ struct ReferenceModel::Impl {
     } else if (positioned) {
       *positioned = pack(x);
     }
-    for (int k = 0; k < 2; ++k) solve_coupled_dir[k] = solve_coupled_dir[k] || zero_coupled_slip[k];
+    for (int k = 0; k < 2; ++k) fresh_coupled_slip[k] = fresh_coupled_slip[k] || zero_coupled_slip[k];
     zero_coupled_slip = {false, false};
     return pack(x);
   }
@@ -872,7 +817,14 @@ struct ReferenceModel::Impl {
         if (dyn.coupled()) {
           // The generalised slip (v, w_z) passes through (or near) zero: stick as a whole if
           // the sticking forces lie in the ellipse, else slide on in the direction they give.
-          if (coupled_speed(dyn.coupled_slip(x, s)) <= slip_eps) {
+          const Vec3 u = dyn.coupled_slip(x, s);
+          if (coupled_speed(u) > slip_eps) {
+            // Not a zero: the slip turned by more than 90 deg from the reference within a step
+            // (fast near a slip start, where the slip is small). The continuation's flip must
+            // not outlive the event (it would make the force drive the slip): the reference
+            // becomes the slip's own direction.
+            next.slot[s].coupled_dir = u.normalized();
+          } else {
             ContactMode trial = next;
             trial.slot[s].stick = trial.slot[s].drill_stick = true;
             const ContactForces f = forces_at(y, trial);
@@ -881,6 +833,11 @@ struct ReferenceModel::Impl {
               next = trial;
               owner.events_.push_back({"stick", te, std::string("slip and spin about the vertical vanish on the ") + slot_name(s) +
                                                         " (coupled law)", demand / f.normal[s]});
+            } else if (u.norm() > coupled_floor) {
+              // A slip that has begun to grow against the reference (just after a slip start,
+              // where its direction is set by the fast, stiff turning of a small slip): the
+              // force follows the slip's own direction from here.
+              next.slot[s].coupled_dir = u.normalized();
             } else {
               next.slot[s].coupled_dir = coupled_slide_dir(f, s);
               zero_coupled_slip[s] = true;

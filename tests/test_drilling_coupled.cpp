@@ -195,48 +195,63 @@ TEST(DrillingCoupled, EnergyLedgerClosesOnTheSpinningBall) {
   EXPECT_LT(worst, 1e-9);
 }
 
-// Stick and slip of the whole law on the Leine-Glocker twin: near the end of its spin (17.1 s)
-// slip and spin vanish together, the contact sticks, and 5 ms later the forces leave the
-// ellipse and it slides again. dopri5: see the DISABLED_ case below for bulirsch_stoer. The
-// ledger closes through both events (the slip start zeroes the drift of the stuck phase and
-// books it).
+// Stick and slip of the whole law on the Leine-Glocker twin run past its scene's horizon: near
+// the end of its spin (17.1 s) slip and spin vanish together, the contact sticks, and 5 ms
+// later the forces leave the ellipse and it slides again. Run to just past the slip (the
+// DISABLED_ case below is what comes after it); sample by sample, as the harness runs it (the
+// no-progress budget is per sample interval). The ledger closes through both events (the slip
+// start zeroes the drift of the stuck phase and books it) and the friction work never
+// decreases: the force never drives the slip (the power of a dissipative law is <= 0 at every
+// quadrature point, so its booked work can only grow; 1e-14 E0 for round-off). The energy
+// itself may rise by the tolerance-sized drift corrections at restarts (booked as drift).
 TEST(DrillingCoupled, StickThenSlipOnTheTwin) {
   Scene s = shipped("leine_glocker_twin_coupled");
-  s.run.method = "dopri5";
-  s.run.duration = 17.2;
+  s.run.duration = 17.1207;
   ReferenceModel m(s);
-  const double e0 = energy(m.body(), m.state());
-  m.advance_to(17.1);
-  const double before = std::abs(energy(m.body(), m.state()) + m.energy_ledger().total() - e0) / e0;
-  m.advance_to(s.run.duration);
+  const BodyModel& b = m.body();
+  const double e0 = energy(b, m.state());
+  double w_prev = 0.0, worst_drop = 0.0, worst_ledger = 0.0;
+  for (int k = 1; k <= 17121 && m.status() == ReferenceStatus::Ok; ++k) {
+    m.advance_to(std::min(1e-3 * k, s.run.duration));
+    const double e = energy(b, m.state()), w = m.energy_ledger().friction;
+    worst_drop = std::max(worst_drop, (w_prev - w) / e0);
+    w_prev = w;
+    if (m.time() > 17.1) worst_ledger = std::max(worst_ledger, std::abs(e + m.energy_ledger().total() - e0) / e0);
+  }
   ASSERT_EQ(m.status(), ReferenceStatus::Ok) << m.status_detail();
   const auto t_stick = first_event(m.events(), "stick"), t_slip = first_event(m.events(), "slip");
   ASSERT_TRUE(t_stick.has_value());
   ASSERT_TRUE(t_slip.has_value());
-  const double after = std::abs(energy(m.body(), m.state()) + m.energy_ledger().total() - e0) / e0;
-  std::printf("twin (dopri5): stick %.10f s, slip %.10f s; ledger residual %.3g E0 before, %.3g after\n", *t_stick, *t_slip,
-              before, after);
+  std::printf("twin: stick %.10f s, slip %.10f s; ledger residual %.3g E0, largest drop of the friction work %.3g E0\n",
+              *t_stick, *t_slip, worst_ledger, worst_drop);
   EXPECT_GT(*t_slip, *t_stick);
   for (const auto& e : m.events()) {
     if (e.name == "stick") {
       EXPECT_LE(e.value, 1.0) << "stuck forces outside the ellipse";
     }
   }
-  EXPECT_LT(after, 1e-9);
+  EXPECT_LT(worst_ledger, 1e-9);
+  EXPECT_LT(worst_drop, 1e-14);
 }
 
-// Measured (Release, 2026-12): with bulirsch_stoer the same run stalls 1.1 ms after the slip
-// start ("no progress: more than 199999 steps from t = 17.121 to 17.122", last step 8.8e-10 s);
-// dopri5 passes it. While the generalised slip is ~1e-10 its direction turns at a rate
-// ~|d(slip)/dt| / |slip| as the state moves on, a stiff phase the extrapolation method's step
-// control does not get through. Left as a documented case; not tuned.
-TEST(DrillingCoupled, DISABLED_StickThenSlipOnTheTwinBulirschStoer) {
-  Scene s = shipped("leine_glocker_twin_coupled");
-  s.run.duration = 17.2;
-  ReferenceModel m(s);
-  // Sample by sample, as the harness runs it: the no-progress budget is per sample interval.
-  for (int k = 1; k <= 17200 && m.status() == ReferenceStatus::Ok; ++k) m.advance_to(1e-3 * k);
-  EXPECT_EQ(m.status(), ReferenceStatus::Ok) << m.status_detail();
+// Measured (Release): after that slip start every method stalls within 0.6 ms, with the energy
+// balanced and not rising: "no progress" at t = 17.12174 (bulirsch_stoer, last step 4.5e-9 s),
+// 17.12098 (dopri5, 8.7e-10 s), 17.12087 (rosenbrock4, 1.1e-10 s). The slip grows from zero
+// with a direction that turns at a rate ~F_n |M| / |slip| (M the generalised mobility, whose
+// translational and drilling parts differ ~1000-fold on this top), a stiff phase no step
+// control here gets through. Before the reference zeroed the stuck drift and counted a start
+// from zero slip as a SlipReversal crossing, dopri5 went on with the force driving the slip
+// (the energy rose from 9e-4 to 2.3e-3 J within 0.14 s): a stall is the honest outcome. Left
+// as a documented case beyond the scene's 10 s horizon; not tuned.
+TEST(DrillingCoupled, DISABLED_SlidesOnAfterTheSlipOnTheTwin) {
+  for (const char* method : {"bulirsch_stoer", "dopri5", "rosenbrock4"}) {
+    Scene s = shipped("leine_glocker_twin_coupled");
+    s.run.method = method;
+    s.run.duration = 17.2;
+    ReferenceModel m(s);
+    for (int k = 1; k <= 17200 && m.status() == ReferenceStatus::Ok; ++k) m.advance_to(1e-3 * k);
+    EXPECT_EQ(m.status(), ReferenceStatus::Ok) << method << ": " << m.status_detail();
+  }
 }
 
 // Leine and Glocker: with the coupled law their top turns over and touches its stem within
