@@ -652,6 +652,7 @@ struct ReferenceModel::Impl {
           if (slot.stick && dyn.coupled_demand(f, s) > f.normal[s]) {
             slot.stick = slot.drill_stick = false;
             slot.coupled_dir = coupled_slide_dir(f, s);
+            zero_coupled_slip[s] = true;  // it starts to slide from (near) zero slip, see handle()
             changed = true;
           }
           continue;
