@@ -61,6 +61,18 @@ Vec3 ContactDynamics::contact_velocity(const BodyState& x, int slot) const {
   return x.v_WG + w_W.cross(geometry(x, slot).r_GC_W);
 }
 
+Vec3 ContactDynamics::coupled_slip(const BodyState& x, int slot) const {
+  const Vec3 v = contact_velocity(x, slot);
+  const double w_z = (x.q_WB.normalized() * x.w_B).z();
+  return Vec3(c_.mu * v.x(), c_.mu * v.y(), c_.drilling * w_z);
+}
+
+double ContactDynamics::coupled_demand(const ContactForces& f, int slot) const {
+  // mu > 0 and mu_d > 0 are the scene reader's conditions for the coupled law.
+  const double ft = std::hypot(f.force_W[slot].x(), f.force_W[slot].y());
+  return std::hypot(ft / c_.mu, f.drill_torque[slot] / c_.drilling);
+}
+
 double ContactDynamics::gap_acceleration(const StateVector& y, const StateVector& dy, int slot) const {
   const BodyState x = unpack(y, 0);
   const Quat q = x.q_WB.normalized();
@@ -146,7 +158,35 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
     };
     // Normal force, carrying the sliding friction and drilling torque that scale with it.
     Vec3 fdir = e_z;
-    if (c_.friction == FrictionLaw::Coulomb && !slot.stick) {
+    double drill_coeff = 0.0;
+    const bool coupled_sliding = coupled() && !slot.stick;
+    if (coupled_sliding) {
+      // Coupled Coulomb-Contensou law in the ellipsoidal approximation of Leine and Glocker
+      // (2003, "A set-valued force law for spatial Coulomb-Contensou friction", Eur. J. Mech.
+      // A/Solids 22, 193-216): the friction force F_t and the drilling torque tau of a contact
+      // lie in the ellipse (|F_t| / (mu F_n))^2 + (tau / (mu_d F_n))^2 <= 1 (the exact
+      // Contensou set of a circular patch of radius a is a convex set with semi-axes mu F_n
+      // and 2/3 mu a F_n; the ellipse through those points replaces it). Sliding is the
+      // principle of maximal dissipation on that set: with the generalised slip
+      // u = (mu v, mu_d w_z) and S = |u|, the dissipation function (the ellipse's support
+      // function) is F_n S, and (F_t, tau) = -grad_(v, w_z) (F_n S), i.e.
+      //   F_t = -mu F_n (mu v) / S,   tau = -mu_d F_n (mu_d w_z) / S,
+      // or, with e = mu_d / mu, F_t = -mu F_n v / sqrt(v^2 + (e w_z)^2) and
+      // tau = -mu_d F_n e w_z / sqrt(v^2 + (e w_z)^2): on the ellipse, and the power
+      // F_t . v + tau w_z = -F_n S <= 0. Unlike the decoupled law, a spinning contact has no
+      // stick of its slip alone: at v = 0 with w_z != 0 the force vanishes and grows linearly
+      // with v (slope mu F_n / (e |w_z|)), so the slip of a spinning top decays smoothly
+      // instead of sticking. The law sticks only where u = 0, v and w_z together. The unit
+      // vector u / S takes the side of the slot's reference direction, as the Coulomb slip
+      // direction below, so that the dense output stays smooth through a zero of u.
+      const Vec3 u(c_.mu * slip.x(), c_.mu * slip.y(), c_.drilling * w_W.z());  // coupled_slip()
+      const double S = u.norm();
+      Vec3 dir = S > slot.coupled_floor ? Vec3(u / S) : slot.coupled_dir;
+      if (dir.dot(slot.coupled_dir) < 0) dir = -dir;
+      fdir -= c_.mu * Vec3(dir.x(), dir.y(), 0.0);
+      drill_coeff = -c_.drilling * dir.z();
+    }
+    if (c_.friction == FrictionLaw::Coulomb && !slot.stick && !coupled_sliding) {
       // Beyond a zero of the slip (reached along a line) s/|s| flips; taking the side of the
       // slot's reference direction continues the sliding law smoothly through it, so the
       // integrator never steps over a kink and the "slip vanishes" event is located on a
@@ -175,8 +215,7 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
       F_known += -c_.k * slip;
       T_known += r.cross(-c_.k * slip);
     }
-    double drill_coeff = 0.0;
-    if (c_.drilling > 0.0 && !slot.drill_stick) {
+    if (c_.drilling > 0.0 && !slot.drill_stick && !coupled_sliding) {
       const double spin_z = w_W.z();
       drill_coeff = spin_z > 0 ? -c_.drilling : (spin_z < 0 ? c_.drilling : 0.0);
     }
@@ -303,7 +342,11 @@ BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touchi
   // friction (a finite force transmits no impulse). Gliding friction is left out of impacts
   // too (normal impulse only): strictly its force -mu F_n v_C follows an impulsive F_n with
   // the impulse -mu integral(v_C dP_n), a simplification of this model that matters only where
-  // a gliding top touches down (the bare ball never does).
+  // a gliding top touches down (the bare ball never does). Drilling friction (either law)
+  // transmits no impulse here either, and under the coupled law the tangential impulse is
+  // bounded by the Coulomb cone alone (mu P_n), not by the ellipse with an impulsive drilling
+  // torque: a simplification that bounds the tangential impulse from above (the ellipse
+  // would share the bound with the spin), and matters only from the first stem touchdown on.
   const bool full_stop = !normal_only && (c_.friction == FrictionLaw::Rolling || c_.friction == FrictionLaw::Coulomb);
 
   struct Solution {

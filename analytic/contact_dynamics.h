@@ -31,6 +31,13 @@ struct ContactSlot {
   // (the slip passing through 0, where both fields meet).
   bool graze = false;
   Vec3 slip_dir_W = Vec3::UnitX();  // Coulomb sliding direction used while |v_C| is ~0
+  // Coupled drilling law only: the sliding direction in the generalised slip space
+  // (mu v_x, mu v_y, mu_d w_z) (lab axes), a unit vector, used while that slip is ~0 (as
+  // slip_dir_W). `stick` and `drill_stick` are then set together: the law sticks only as a whole.
+  Vec3 coupled_dir = Vec3::UnitX();
+  // Coupled law: below this generalised slip |(mu v, mu_d w_z)| the direction is coupled_dir
+  // (a slip zeroed at a restart is round-off, whose direction means nothing).
+  double coupled_floor = 0.0;
 };
 
 struct ContactMode {
@@ -96,6 +103,18 @@ class ContactDynamics {
 
   const BodyModel& body() const { return m_; }
   const ContactSpec& contact() const { return c_; }
+
+  // The coupled Coulomb-Contensou law is in force (Coulomb friction, drilling_law = coupled).
+  bool coupled() const {
+    return c_.friction == FrictionLaw::Coulomb && c_.drilling_law == DrillingLaw::Coupled;
+  }
+  // Coupled law: the generalised slip (mu v_x, mu v_y, mu_d w_z) of slot s (lab axes; v the
+  // horizontal velocity of the material point at C, w_z the spin about the vertical); its norm
+  // over F_n's coefficient is the dissipation rate per unit normal force.
+  Vec3 coupled_slip(const BodyState& x, int slot) const;
+  // Coupled law: the normal force the friction of slot s needs to lie on the ellipse,
+  // sqrt((|F_t| / mu)^2 + (tau / mu_d)^2): the contact sticks while it is <= F_n.
+  double coupled_demand(const ContactForces& f, int slot) const;
 
  private:
   // evaluate() with every grazing contact carrying the fixed share `share` of its viscous force.

@@ -17,6 +17,14 @@ const char* to_string(FrictionLaw law) {
   return "?";
 }
 
+const char* to_string(DrillingLaw law) {
+  switch (law) {
+    case DrillingLaw::Decoupled: return "decoupled";
+    case DrillingLaw::Coupled: return "coupled";
+  }
+  return "?";
+}
+
 const char* to_string(MassModel model) {
   switch (model) {
     case MassModel::Seed: return "seed";

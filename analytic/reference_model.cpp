@@ -199,6 +199,7 @@ struct ReferenceModel::Impl {
   std::vector<EvFn> fns;
   std::vector<double> g_start;
   std::array<Vec3, 2> ref_dir{Vec3::UnitX(), Vec3::UnitX()};
+  std::array<Vec3, 2> ref_coupled{Vec3::UnitX(), Vec3::UnitX()};  // coupled law: see ContactSlot::coupled_dir
   double drill_ref_sign = 1.0;
   bool pending = false;
   EvFn pending_fn{EvKind::Inversion, 0};
@@ -211,6 +212,15 @@ struct ReferenceModel::Impl {
   std::array<double, 2> flight_max_gap{0.0, 0.0};
   bool unresolved_noted = false;
   double v_scale = 0.0, slip_eps = 0.0;
+  // Coupled law: the generalised slip below which its direction is the slot's reference
+  // (ContactSlot::coupled_floor): 1e-3 of the stick threshold, far above the round-off of a
+  // slip zeroed at a restart and far below any slip the motion resolves.
+  double coupled_floor = 0.0;
+  // Coupled law, per slot: a contact that has just left stick starts from exactly zero slip
+  // (project() zeroes the drift of the stuck integration), so that it starts sliding in the
+  // direction the stuck forces give (coupled_slide_dir), not in that of the drift.
+  std::array<bool, 2> zero_coupled_slip{false, false};
+  std::array<bool, 2> fresh_coupled_slip{false, false};  // ... and its SlipReversal starts positive (restart)
   double dt_hint = 0.0;
   std::string failure_hint;  // appended to a "non-finite state" failure: what to try instead
   long long events_in_burst = 0;
@@ -254,8 +264,11 @@ struct ReferenceModel::Impl {
         fns.push_back({EvKind::GrazePinch, s});
       } else if (slot.active) {
         fns.push_back({EvKind::NormalForce, s});
+        // Under the coupled law, SlipReversal and ConeExit watch the generalised slip and the
+        // ellipse (the law sticks and slips as a whole); there are no drilling events of its own.
         if (c.friction == FrictionLaw::Coulomb) fns.push_back({slot.stick ? EvKind::ConeExit : EvKind::SlipReversal, s});
-        if (c.drilling > 0) fns.push_back({slot.drill_stick ? EvKind::DrillConeExit : EvKind::DrillReversal, s});
+        if (c.drilling > 0 && !dyn.coupled())
+          fns.push_back({slot.drill_stick ? EvKind::DrillConeExit : EvKind::DrillReversal, s});
       } else {
         fns.push_back({EvKind::Touchdown, s});
       }
@@ -272,7 +285,24 @@ struct ReferenceModel::Impl {
     }
     const double wz = (unpack(y, 0).q_WB.normalized() * unpack(y, 0).w_B).z();
     drill_ref_sign = wz >= 0 ? 1.0 : -1.0;
+    if (dyn.coupled())
+      for (int s = 0; s < 2; ++s) {
+        const Vec3 u = coupled_slip(f, wz, s);
+        const double S = u.norm();
+        Vec3 dir = S > mode.slot[s].coupled_floor ? Vec3(u / S) : mode.slot[s].coupled_dir;
+        if (dir.dot(mode.slot[s].coupled_dir) < 0) dir = -dir;
+        mode.slot[s].coupled_dir = ref_coupled[s] = dir;
+      }
   }
+
+  // The coupled law's generalised slip (mu v_x, mu v_y, mu_d w_z) from the slip the forces
+  // report (ContactDynamics::coupled_slip, without normalizing the state again).
+  Vec3 coupled_slip(const ContactForces& f, double w_z, int s) const {
+    const ContactSpec& c = dyn.contact();
+    return Vec3(c.mu * f.slip_W[s].x(), c.mu * f.slip_W[s].y(), c.drilling * w_z);
+  }
+  // Its size in velocity units, |(v, (mu_d / mu) w_z)|, for the stick threshold slip_eps.
+  double coupled_speed(const Vec3& u) const { return u.norm() / dyn.contact().mu; }
 
   double g(const EvFn& fn, const StateVector& y, const ContactForces* f) {
     const BodyState x = unpack(y, 0.0);
@@ -313,8 +343,12 @@ struct ReferenceModel::Impl {
       // source_dimensionless a0 is then ~-3e-6 g and crosses 0 ~5e-5 time units later: the
       // lift it makes early moves the gap by ~1e-15 R, far below any resolution.
       case EvKind::GrazePinch: return cf.graze_loaded_accel[s] - cf.graze_lifted_accel[s] - 1e-5 * dyn.body().g;
-      case EvKind::SlipReversal: return cf.slip_W[s].dot(ref_dir[s]);
-      case EvKind::ConeExit: return c.mu * cf.normal[s] - std::hypot(cf.force_W[s].x(), cf.force_W[s].y());
+      case EvKind::SlipReversal:
+        if (dyn.coupled()) return coupled_slip(cf, (q * x.w_B).z(), s).dot(ref_coupled[s]);
+        return cf.slip_W[s].dot(ref_dir[s]);
+      case EvKind::ConeExit:
+        if (dyn.coupled()) return cf.normal[s] - dyn.coupled_demand(cf, s);
+        return c.mu * cf.normal[s] - std::hypot(cf.force_W[s].x(), cf.force_W[s].y());
       case EvKind::DrillConeExit: return c.drilling * cf.normal[s] - std::abs(cf.drill_torque[s]);
       default: return 0.0;
     }
@@ -431,6 +465,14 @@ struct ReferenceModel::Impl {
     build_event_functions();
     refresh_references(y);
     g_start = g_all(y);
+    // A coupled contact that starts to slide from zero slip starts on the positive side of its
+    // SlipReversal function (0 there): the continuation's flip of the direction makes a slip
+    // that grows against the reference a self-consistent motion in which the force drives the
+    // slip; a crossing from exactly 0 would not be bracketed, so it is counted as one.
+    for (size_t i = 0; i < fns.size(); ++i)
+      if (fns[i].kind == EvKind::SlipReversal && dyn.coupled() && fresh_coupled_slip[fns[i].slot] && !(g_start[i] > 0))
+        g_start[i] = std::numeric_limits<double>::denorm_min();
+    fresh_coupled_slip = {false, false};
     track_graze(graze_last);
     pending = false;
     ledger_t = t;
@@ -555,6 +597,16 @@ struct ReferenceModel::Impl {
     refresh_references(y1);
   }
 
+  // Coupled law: the direction of the generalised slip in which a contact whose sticking
+  // forces (F_t, tau) have left the ellipse starts to slide: the slip that makes the sliding
+  // law's force point as the sticking one does, u ~ -(F_t / mu, tau / mu_d) (the normal of
+  // the ellipse at (F_t, tau) scaled back to its boundary).
+  Vec3 coupled_slide_dir(const ContactForces& f, int s) const {
+    const ContactSpec& c = dyn.contact();
+    const Vec3 u(-f.force_W[s].x() / c.mu, -f.force_W[s].y() / c.mu, -f.drill_torque[s] / c.drilling);
+    return u.norm() > 0 ? Vec3(u.normalized()) : ref_coupled[s];
+  }
+
   ContactMode settle(const StateVector& y, std::array<bool, 2> candidates, const ContactMode& prev) {
     const ContactSpec& c = dyn.contact();
     ContactMode m;
@@ -565,8 +617,14 @@ struct ReferenceModel::Impl {
       slot.slip_dir_W = prev.slot[s].slip_dir_W;
       slot.drill_stick = prev.slot[s].active && prev.slot[s].drill_stick;
       slot.graze = false;
+      slot.coupled_dir = prev.slot[s].coupled_dir;
+      slot.coupled_floor = coupled_floor;
       if (c.friction == FrictionLaw::Rolling) slot.stick = true;
-      if (c.friction == FrictionLaw::Coulomb) {
+      if (c.friction == FrictionLaw::Coulomb && dyn.coupled()) {
+        const Vec3 u = dyn.coupled_slip(x, s);
+        slot.stick = slot.drill_stick = coupled_speed(u) <= slip_eps;
+        if (!slot.stick) slot.coupled_dir = u.normalized();
+      } else if (c.friction == FrictionLaw::Coulomb) {
         Vec3 v = dyn.contact_velocity(x, s);
         v.z() = 0;
         slot.stick = v.norm() <= slip_eps;
@@ -590,6 +648,15 @@ struct ReferenceModel::Impl {
       for (int s = 0; s < 2; ++s) {
         ContactSlot& slot = m.slot[s];
         if (!slot.active) continue;
+        if (dyn.coupled()) {
+          if (slot.stick && dyn.coupled_demand(f, s) > f.normal[s]) {
+            slot.stick = slot.drill_stick = false;
+            slot.coupled_dir = coupled_slide_dir(f, s);
+            zero_coupled_slip[s] = true;  // it starts to slide from (near) zero slip, see handle()
+            changed = true;
+          }
+          continue;
+        }
         if (c.friction == FrictionLaw::Coulomb && slot.stick) {
           const Vec3 ft(f.force_W[s].x(), f.force_W[s].y(), 0.0);
           if (ft.norm() > c.mu * f.normal[s]) {
@@ -630,6 +697,14 @@ struct ReferenceModel::Impl {
         x.w_B = x.q_WB.conjugate() * w_W;
       }
     }
+    if (dyn.coupled())
+      for (int k = 0; k < 2; ++k)
+        if (mode.slot[k].active && (mode.slot[k].stick || zero_coupled_slip[k])) {
+          // The coupled law sticks as a whole: the spin about the vertical is held at zero too.
+          Vec3 w_W = x.q_WB * x.w_B;
+          w_W.z() = 0.0;
+          x.w_B = x.q_WB.conjugate() * w_W;
+        }
     if (s >= 0) {
       const ContactGeometry geo = dyn.geometry(x, s);
       const Vec3 w_W = x.q_WB * x.w_B;
@@ -645,7 +720,7 @@ struct ReferenceModel::Impl {
         x.w_B = held.w_B;
       } else {
         x.v_WG.z() = -w_W.cross(geo.r_GO_W).z();
-        if (mode.slot[s].stick) {
+        if (mode.slot[s].stick || (dyn.coupled() && zero_coupled_slip[s])) {
           Vec3 slip = dyn.contact_velocity(x, s);
           slip.z() = 0;
           x.v_WG -= slip;
@@ -654,6 +729,8 @@ struct ReferenceModel::Impl {
     } else if (positioned) {
       *positioned = pack(x);
     }
+    for (int k = 0; k < 2; ++k) fresh_coupled_slip[k] = fresh_coupled_slip[k] || zero_coupled_slip[k];
+    zero_coupled_slip = {false, false};
     return pack(x);
   }
 
@@ -738,6 +815,37 @@ struct ReferenceModel::Impl {
         break;
       }
       case EvKind::SlipReversal: {
+        if (dyn.coupled()) {
+          // The generalised slip (v, w_z) passes through (or near) zero: stick as a whole if
+          // the sticking forces lie in the ellipse, else slide on in the direction they give.
+          const Vec3 u = dyn.coupled_slip(x, s);
+          if (coupled_speed(u) > slip_eps) {
+            // Not a zero: the slip turned by more than 90 deg from the reference within a step
+            // (fast near a slip start, where the slip is small). The continuation's flip must
+            // not outlive the event (it would make the force drive the slip): the reference
+            // becomes the slip's own direction.
+            next.slot[s].coupled_dir = u.normalized();
+          } else {
+            ContactMode trial = next;
+            trial.slot[s].stick = trial.slot[s].drill_stick = true;
+            const ContactForces f = forces_at(y, trial);
+            const double demand = dyn.coupled_demand(f, s);
+            if (demand <= f.normal[s]) {
+              next = trial;
+              owner.events_.push_back({"stick", te, std::string("slip and spin about the vertical vanish on the ") + slot_name(s) +
+                                                        " (coupled law)", demand / f.normal[s]});
+            } else if (u.norm() > coupled_floor) {
+              // A slip that has begun to grow against the reference (just after a slip start,
+              // where its direction is set by the fast, stiff turning of a small slip): the
+              // force follows the slip's own direction from here.
+              next.slot[s].coupled_dir = u.normalized();
+            } else {
+              next.slot[s].coupled_dir = coupled_slide_dir(f, s);
+              zero_coupled_slip[s] = true;
+            }
+          }
+          break;
+        }
         Vec3 v = dyn.contact_velocity(x, s);
         v.z() = 0;
         if (v.norm() <= slip_eps) {
@@ -756,6 +864,13 @@ struct ReferenceModel::Impl {
       }
       case EvKind::ConeExit: {
         const ContactForces f = forces_at(y, mode);
+        if (dyn.coupled()) {
+          next.slot[s].stick = next.slot[s].drill_stick = false;
+          next.slot[s].coupled_dir = coupled_slide_dir(f, s);
+          zero_coupled_slip[s] = true;
+          owner.events_.push_back({"slip", te, std::string("friction and drilling torque leave the ellipse on the ") + slot_name(s) + " (coupled law)", 0.0});
+          break;
+        }
         const Vec3 ft(f.force_W[s].x(), f.force_W[s].y(), 0.0);
         next.slot[s].stick = false;
         next.slot[s].slip_dir_W = ft.norm() > 0 ? Vec3(-ft.normalized()) : ref_dir[s];
@@ -902,6 +1017,7 @@ ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene
   const double v_scale = std::max({x0.v_WG.norm(), x0.w_B.norm() * body_.R, std::sqrt(body_.g * body_.R)});
   impl_->v_scale = v_scale;
   impl_->slip_eps = std::max(1e-7, 10.0 * scene.run.rtol) * v_scale;
+  impl_->coupled_floor = 1e-3 * impl_->slip_eps * scene.contact.mu;
   const double period = std::min(2 * M_PI / std::max(x0.w_B.norm(), 1e-9), std::sqrt(body_.R / body_.g));
   impl_->dt_hint = 1e-3 * period;
   if (scene.contact.friction == FrictionLaw::Viscous && scene.contact.k > 0 && scene.run.method != "rosenbrock4") {

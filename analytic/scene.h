@@ -11,8 +11,13 @@ namespace tippe {
 
 enum class FrictionLaw { Rolling, Viscous, Coulomb, None, Gliding };
 enum class MassModel { Seed, Solid, Given };
+// How the drilling torque of a Coulomb contact relates to its tangential force: each bounded
+// on its own (|F_t| <= mu F_n, |tau| <= mu_d F_n), or jointly by the ellipse of Leine and
+// Glocker's approximation of the Coulomb-Contensou law (contact_dynamics.cpp).
+enum class DrillingLaw { Decoupled, Coupled };
 
 const char* to_string(FrictionLaw law);
+const char* to_string(DrillingLaw law);
 const char* to_string(MassModel model);
 
 // Geometry of the sphere+stem body. l is measured from the ball centre O to the centre P of the
@@ -40,6 +45,8 @@ struct ContactSpec {
   double mu = 0.0;        // Coulomb coefficient; gliding (Rutstam 2012): F_t = -mu F_n v_C, mu in s/m
   double k = 0.0;         // viscous coefficient, F_t = -k v_C
   double drilling = 0.0;  // torsional friction length mu_d: |tau| <= mu_d F_n
+  // Coupled (Coulomb law only): (|F_t| / (mu F_n))^2 + (tau / (mu_d F_n))^2 <= 1.
+  DrillingLaw drilling_law = DrillingLaw::Decoupled;
   bool stem = true;       // false: a bare eccentric ball
   bool flight = false;    // true: free flight after loss of contact instead of ending the run
 };

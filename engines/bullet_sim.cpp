@@ -353,6 +353,10 @@ void BulletSimulator::make_notes() {
     notes_.push_back("drilling friction as Bullet's spinning friction, |tau| <= mu_d P_n per contact point; Bullet adds that row only "
                      "with rolling friction > 0, so a rolling resistance of " + short_num(rolling_) +
                      " (length) is set: rolling torque <= " + short_num(kRollingGateOverR) + " R F_n");
+  if (sc.contact.drilling > 0 && sc.contact.drilling_law == DrillingLaw::Coupled)
+    notes_.push_back("drilling decoupled: Bullet bounds the spinning torque (|tau| <= mu_d P_n) and the friction force (mu P_n) in "
+                     "rows of their own; the scene's coupled law bounds them jointly (Leine-Glocker ellipse), which Bullet cannot "
+                     "represent: this run is the decoupled law");
   if (!settings_.split_impulse)
     notes_.push_back("penetration removed by Baumgarte velocity (split_impulse = false): the correction adds kinetic energy");
   else if (settings_.split_impulse_threshold < 0)

@@ -443,9 +443,22 @@ void MujocoSimulator::make_notes(const std::string& compiler_warning) {
   if (condim_ >= 3 && (c.friction == FrictionLaw::Coulomb || c.friction == FrictionLaw::Rolling) &&
       settings_.cone == "pyramidal")
     notes_.push_back("friction cone approximated by MuJoCo's pyramid (cone = pyramidal)");
-  if (condim_ >= 4 && c.drilling > 0)
+  // The scene's drilling law against MuJoCo's cone: the elliptic cone with condim >= 4 is the
+  // coupled law's ellipse itself (MuJoCo: f_n^2 >= sum f_i^2 / mu_i^2), so a coupled scene runs
+  // natively and a decoupled one does not; the pyramid bounds them jointly too, by a polytope.
+  const bool coupled = c.drilling_law == DrillingLaw::Coupled;
+  if (condim_ >= 4 && c.drilling > 0 && settings_.cone == "elliptic" && !coupled)
     notes_.push_back("drilling friction (condim " + std::to_string(condim_) +
                      "): MuJoCo bounds the tangential force and the drilling torque jointly, (|F_t|/mu)^2 + (tau/mu_d)^2 <= F_n^2 (elliptic), not each alone");
+  if (condim_ >= 4 && c.drilling > 0 && settings_.cone == "elliptic" && coupled)
+    notes_.push_back("drilling coupled natively (condim " + std::to_string(condim_) +
+                     ", elliptic cone): MuJoCo's cone (|F_t|/mu)^2 + (tau/mu_d)^2 <= F_n^2 is the scene's Leine-Glocker ellipse");
+  if (condim_ >= 4 && c.drilling > 0 && settings_.cone == "pyramidal")
+    notes_.push_back(std::string("drilling ") + (coupled ? "coupled by a polytope, not the scene's ellipse" : "coupled, not each bounded alone") +
+                     " (condim " + std::to_string(condim_) +
+                     ", cone = pyramidal): MuJoCo's pyramid bounds the tangential force and the drilling torque jointly by its edges n +- mu_i d_i");
+  if (coupled && c.drilling > 0 && condim_ < 4)
+    notes_.push_back("drilling dropped (condim " + std::to_string(condim_) + " has no torsional row): not the scene's coupled law");
   // MuJoCo raises every friction coefficient the contact uses to mjMINMU.
   const Vec3 f = used_friction(settings_, scene());
   const bool zero_used = (condim_ >= 3 && !(f.x() > 0)) || (condim_ >= 4 && !(f.y() > 0)) || condim_ == 6;

@@ -380,6 +380,10 @@ void OdeSimulator::make_notes() {
     os << v;
     return os.str();
   };
+  if (sc.contact.drilling > 0 && sc.contact.drilling_law == DrillingLaw::Coupled)
+    notes_.push_back("drilling decoupled: ODE bounds the spin torque (rhoN, |tau| <= mu_d F_n) and the friction force in rows of "
+                     "their own; the scene's coupled law bounds them jointly (Leine-Glocker ellipse), which ODE cannot "
+                     "represent: this run is the decoupled law");
   if (sc.contact.friction == FrictionLaw::Rolling)
     notes_.push_back("rolling approximated by Coulomb friction with mu = " + num(settings_.rolling_mu) +
                      (approx1 ? " (coefficient, approx1)" : " (force bound, box)"));

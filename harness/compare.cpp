@@ -333,6 +333,11 @@ std::string physics_hash(const json& scene_json) {
   for (const char* key : {"engines", "name", "description", "source_file", "content_hash", "notes"}) physics.erase(key);
   // Whether the reference is checked is not physics: the same reference serves both.
   if (physics.contains("run") && physics["run"].is_object()) physics["run"].erase("self_check");
+  // The drilling law at its default is left out: records made before the key existed describe
+  // the same physics and keep their hash.
+  if (physics.contains("contact") && physics["contact"].is_object() &&
+      physics["contact"].value("drilling_law", std::string("decoupled")) == "decoupled")
+    physics["contact"].erase("drilling_law");
   // nlohmann::json keeps object keys sorted, so dump() is canonical.
   const std::string text = physics.dump();
   std::uint64_t h = 14695981039346656037ull;

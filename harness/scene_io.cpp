@@ -279,7 +279,7 @@ class Interpreter {
   }
 
   void read_contact(const toml::table& t, ContactSpec& c) const {
-    keys(t, "contact", {"friction", "mu", "k", "drilling", "stem", "flight"});
+    keys(t, "contact", {"friction", "mu", "k", "drilling", "drilling_law", "stem", "flight"});
     const auto law = opt_string(t, "contact", "friction");
     if (!law) fail("contact.friction", "missing (required: rolling, viscous, gliding, coulomb or none)");
     if (*law == "rolling") c.friction = FrictionLaw::Rolling;
@@ -308,6 +308,21 @@ class Interpreter {
     } else {
       c.drilling = opt_number(t, "contact", "drilling").value_or(0.0);
       if (!(c.drilling >= 0)) out_of_range("contact.drilling", c.drilling, "drilling >= 0");
+    }
+    // The coupled Coulomb-Contensou law bounds the Coulomb force and the drilling torque
+    // jointly: it needs both bounds (mu > 0, mu_d > 0) and the Coulomb law to couple to.
+    const std::string drill_law = opt_string(t, "contact", "drilling_law").value_or("decoupled");
+    if (drill_law == "decoupled") {
+      c.drilling_law = DrillingLaw::Decoupled;
+    } else if (drill_law == "coupled") {
+      c.drilling_law = DrillingLaw::Coupled;
+      if (c.friction != FrictionLaw::Coulomb)
+        fail("contact.drilling_law", std::string("\"coupled\" needs friction = \"coulomb\" (it bounds the Coulomb force and the "
+                                     "drilling torque jointly), got friction = \"") + *law + "\"");
+      if (!(c.mu > 0)) fail("contact.drilling_law", "\"coupled\" needs contact.mu > 0, got " + num(c.mu));
+      if (!(c.drilling > 0)) fail("contact.drilling_law", "\"coupled\" needs contact.drilling > 0 (mu_d, the bound of the drilling torque per unit normal force), got " + num(c.drilling));
+    } else {
+      fail("contact.drilling_law", "unknown law \"" + drill_law + "\" (expected decoupled or coupled)");
     }
     c.stem = opt_bool(t, "contact", "stem").value_or(true);
     c.flight = opt_bool(t, "contact", "flight").value_or(false);
@@ -644,6 +659,7 @@ nlohmann::json scene_to_json(const Scene& s) {
         {"mu", s.contact.mu},
         {"k", s.contact.k},
         {"drilling", s.contact.drilling},
+        {"drilling_law", to_string(s.contact.drilling_law)},
         {"stem", s.contact.stem},
         {"flight", s.contact.flight}}},
       {"initial",

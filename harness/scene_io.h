@@ -48,7 +48,9 @@ class SceneError : public std::runtime_error {
 //    N s/m), gliding needs mu >= 0 (F_t = -mu F_n v_C, Rutstam 2012: mu in s/m). A coefficient
 //    of another law (mu with viscous, k with coulomb or gliding, ...) is accepted only when it is 0, so one template can
 //    carry every key without silently changing the physics; drilling (>= 0) applies to every
-//    law but "none", where it too must be 0.
+//    law but "none", where it too must be 0. contact.drilling_law: "decoupled" (default) or
+//    "coupled" (Leine and Glocker's ellipse), which needs friction = "coulomb", mu > 0 and
+//    drilling > 0.
 //  - initial: rolling derives the velocity of G, so initial.velocity is rejected with it;
 //    omega_along_contact takes its magnitude from spin and so cannot be combined with omega.
 //  - [engines.NAME] tables are copied into Scene::engines (bool, integer -> long long,
