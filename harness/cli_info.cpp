@@ -58,10 +58,8 @@ int info(const InfoOptions& o) {
   std::printf("inertia A, C       %.10g, %.10g\n", m.inertia_transverse, m.inertia_axial);
   std::printf("alpha = d/R        %.10g\n", alpha);
   std::printf("A/C                %.10g\n", ratio);
-  std::printf("can invert         %s
-", inversion_condition_text(alpha, ratio).c_str());
-  std::printf("contact            %s, mu = %g, k = %g, drilling = %g (%s), flight %s
-", to_string(s.contact.friction),
+  std::printf("can invert         %s\n", inversion_condition_text(alpha, ratio).c_str());
+  std::printf("contact            %s, mu = %g, k = %g, drilling = %g (%s), flight %s\n", to_string(s.contact.friction),
               s.contact.mu, s.contact.k, s.contact.drilling, to_string(s.contact.drilling_law), s.contact.flight ? "on" : "off");
   std::printf("run                duration %g, sample interval %g, rtol %g, atol %g\n", s.run.duration,
               s.run.sample_interval, s.run.rtol, s.run.atol);
