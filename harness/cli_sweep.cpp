@@ -8,6 +8,7 @@
 
 #include "cli.h"
 #include "mpi_farm.h"
+#include "sweep_search.h"
 #include "scene_io.h"
 #include "sweep.h"
 
@@ -109,7 +110,7 @@ int run_local(const SweepCliOptions& o) {
   const SweepPlan plan = load_sweep(o.sweep);
   SweepOutcome r;
   try {
-    r = run_sweep(plan, opts);
+    r = run_search_sweep(plan, opts);
   } catch (const SweepInputError& e) {
     throw UsageError(e.what());
   }
@@ -151,7 +152,7 @@ int run_mpi(const SweepCliOptions& o, const MpiSession& mpi) {
   if (!verdict.empty()) throw UsageError(verdict);
   SweepOutcome r;
   try {
-    r = run_sweep(*plan, opts, *farm);
+    r = run_search_sweep(*plan, opts, *farm);
   } catch (const SweepInputError& e) {
     throw UsageError(e.what());
   }
