@@ -341,7 +341,8 @@ GateFile load_gate_file(const std::string& path) {
                      std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
   }
 
-  reader.keys(root, "", {"defaults", "check"});
+  // [[boundary]] checks bound a sweep's boundary search instead (gate_boundary.h).
+  reader.keys(root, "", {"defaults", "check", "boundary"});
   Spec defaults;
   defaults.key = "defaults";
   if (const toml::node* d = root.get("defaults")) {
@@ -350,7 +351,12 @@ GateFile load_gate_file(const std::string& path) {
     defaults = reader.spec(*t, "defaults", true);
   }
   const toml::node* cn = root.get("check");
-  if (!cn) reader.fail("check", "no checks (a gate file needs one or more [[check]] tables)");
+  if (!cn && root.get("boundary")) {
+    GateFile only_boundaries;
+    only_boundaries.file = path;
+    return only_boundaries;
+  }
+  if (!cn) reader.fail("check", "no checks (a gate file needs one or more [[check]] or [[boundary]] tables)");
   const auto* checks = cn->as_array();
   if (!checks) reader.fail("check", "expected [[check]] tables, got " + toml_value_text(*cn));
   if (checks->empty()) reader.fail("check", "no checks (a gate file needs one or more [[check]] tables)");

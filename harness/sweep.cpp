@@ -248,7 +248,7 @@ class SweepReader {
     for (size_t i = 0; i < setups.size(); ++i) {
       const std::string key = idx("setup", i);
       const toml::table& t = table(*setups.get(i), key);
-      keys(t, key, {"name", "engine", "set", "ladder", "grid"});
+      keys(t, key, {"name", "engine", "set", "ladder", "grid", "scenes"});
       SweepSetup u;
       const toml::node* name = t.get("name");
       if (!name) fail(key + ".name", "missing (required)");
@@ -278,6 +278,17 @@ class SweepReader {
           check_setting_key(u.engine, k, sk);
           if (!set_keys.insert(k).second) fail(sk, k + " is set twice");
           u.set.push_back(o);
+        }
+      }
+      if (const toml::node* only = t.get("scenes")) {
+        // Names, checked against the scenes' once they are loaded (load_sweep).
+        const toml::array& a = array(*only, key + ".scenes");
+        if (a.empty()) fail(key + ".scenes", "must name at least one scene (leave it out for every scene)");
+        for (size_t j = 0; j < a.size(); ++j) {
+          const std::string n = string(*a.get(j), idx(key + ".scenes", j));
+          if (std::find(u.only_scenes.begin(), u.only_scenes.end(), n) != u.only_scenes.end())
+            fail(idx(key + ".scenes", j), "\"" + utf8_replaced(n.substr(0, 40)) + "\" is listed twice");
+          u.only_scenes.push_back(n);
         }
       }
       const toml::node* ladder = t.get("ladder");
@@ -442,11 +453,20 @@ SweepPlan load_sweep(const std::string& path) {
     scene_overrides.push_back(over);
   }
 
+  for (size_t u = 0; u < s.setups.size(); ++u)
+    for (size_t j = 0; j < s.setups[u].only_scenes.size(); ++j)
+      if (!scene_names.count(s.setups[u].only_scenes[j])) {
+        std::string list;
+        for (const auto& [n, k] : scene_names) list += (list.empty() ? "" : ", ") + n;
+        reader.fail(idx(idx("setup", u) + ".scenes", j), "\"" + utf8_replaced(s.setups[u].only_scenes[j].substr(0, 40)) +
+                                                             "\" is not the name of a scene of this sweep (expected one of: " + list + ")");
+      }
   std::vector<std::string> ids;
   for (size_t i = 0; i < s.scenes.size(); ++i) {
     const std::string& file = s.scenes[i].path;
     for (size_t u = 0; u < s.setups.size(); ++u) {
       const SweepSetup& setup = s.setups[u];
+      if (!setup.runs_on(plan.scenes[i].name)) continue;
       const std::string key = idx("setup", u);
       std::vector<std::string> over = scene_overrides[i];
       over.insert(over.end(), setup.set.begin(), setup.set.end());

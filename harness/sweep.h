@@ -1,6 +1,7 @@
 // Work-precision sweeps: sweep files, their points, resumable runs into records.jsonl, and the report's analysis.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <filesystem>
 #include <functional>
@@ -64,6 +65,13 @@ struct SweepSetup {
   // A boundary search: ladder_values are its coarse grid (the points planned up front); the
   // bisection's points come in waves (sweep_search.h), each with its own value.
   std::optional<SweepSearch> search;
+  // `scenes = ["toy_viscous", ...]`: the names of the sweep's scenes this setup runs on (empty:
+  // every scene), for a setup that means nothing on some (an inversion-time criterion where the
+  // reference does not invert).
+  std::vector<std::string> only_scenes;
+  bool runs_on(const std::string& scene) const {
+    return only_scenes.empty() || std::find(only_scenes.begin(), only_scenes.end(), scene) != only_scenes.end();
+  }
   // Points of this setup: ladder values times grid values (1 without a grid).
   size_t point_count() const { return ladder_values.size() * (has_grid() ? grid_values.size() : 1); }
 };
@@ -116,7 +124,10 @@ struct SweepPlan {
 //    is_valid_name, or all booleans), grid = {key, values} (optional, the same rules; its key
 //    other than the ladder's). A setup may only touch its engine's settings (engines.ENGINE.*)
 //    or, for the analytic model, run.rtol, run.atol and run.method: a sweep never changes the
-//    physics. Neither axis' key may also be in `set`.
+//    physics. Neither axis' key may also be in `set`. Instead of values, the ladder may be a
+//    boundary search, ladder.search = {key, from, to, criterion, resolution, per_decade}
+//    (read_search, sweep_search.h). scenes (optional): names of the sweep's scenes the setup runs
+//    on, each once (default: every scene).
 //  - every scene with every setup, ladder and grid value must load (the scene's checks and
 //    validate_engine_settings: a value the engine setting refuses, "pyramid" for a cone, is
 //    refused here); the scene's message is quoted after the sweep key

@@ -210,7 +210,7 @@ std::vector<SearchPoint> search_frontier(const SweepPlan& plan, const std::vecto
   for (size_t i = 0; i < plan.scenes.size(); ++i)
     for (size_t u = 0; u < plan.spec.setups.size(); ++u) {
       const SweepSetup& setup = plan.spec.setups[u];
-      if (!setup.search) continue;
+      if (!setup.search || !setup.runs_on(plan.scenes[i].name)) continue;
       const SearchCriterion crit = parse_criterion(setup.search->criterion);
       const size_t grids = setup.has_grid() ? setup.grid_values.size() : 1;
       for (size_t g = 0; g < grids; ++g) {

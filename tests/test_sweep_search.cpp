@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "gate.h"
+#include "gate_boundary.h"
+#include "simulator.h"
 #include "scene_io.h"
 #include "sweep.h"
 #include "sweep_search.h"
@@ -497,6 +499,127 @@ TEST(SweepSearchEndToEnd, RealSearchFindsOdesStepAndResumesToTheSameRecords) {
     ASSERT_EQ(e.code, 0) << slurp(err);
     EXPECT_EQ(records_of(cut), records_of(whole)) << "resumed after " << keep << " records";
   }
+}
+
+// ---- the shipped boundaries sweep ------------------------------------------------------------
+
+TEST(SweepSearchShipped, BoundariesCoverEveryEngineAndEveryShippedScene) {
+  const SweepPlan plan = load_sweep(kSource + "/harness/sweeps/boundaries.toml");
+  std::set<std::string> scenes;
+  for (const Scene& s : plan.scenes) scenes.insert(s.name);
+  for (const auto& f : fs::directory_iterator(kSource + "/harness/scenes")) {
+    if (f.path().extension() != ".toml") continue;
+    EXPECT_TRUE(scenes.count(load_scene(f.path().string()).name)) << f.path() << " is not in boundaries.toml";
+  }
+  std::set<std::string> regime, inversion;
+  for (const SweepSetup& u : plan.spec.setups) {
+    ASSERT_TRUE(u.search) << u.name;
+    EXPECT_EQ(u.search->resolution, 0.05);
+    if (u.search->criterion == "regime") {
+      EXPECT_TRUE(u.only_scenes.empty()) << u.name << ": the regime is asked on every scene";
+      regime.insert(u.engine);
+    } else {
+      EXPECT_EQ(u.search->criterion, "inversion_time_rel_error <= 0.01");
+      // Where the reference inverts (reports/<scene>/report.md): the others would be n/a.
+      EXPECT_EQ(u.only_scenes, (std::vector<std::string>{"source_dimensionless", "toy_viscous", "rutstam_ball",
+                                                          "rutstam_gliding_ball"}));
+      inversion.insert(u.engine);
+    }
+  }
+  for (const std::string& e : available_engines()) {
+    if (e == "analytic") continue;
+    EXPECT_TRUE(regime.count(e)) << e << " has no regime search";
+    EXPECT_TRUE(inversion.count(e)) << e << " has no inversion-time search";
+  }
+  // Planned up front: the coarse grids (5 values over 4 decades) of 10 x 3 regime searches and 4 x 3 others.
+  EXPECT_EQ(plan.planned, 5u * (10 * 3 + 4 * 3));
+}
+
+TEST(SweepSearchInput, SetupScenesNameScenesOfTheSweep) {
+  TempDir dir;
+  std::string text = sweep_text();
+  text.replace(text.find("name = \"ode-ladder\""), 19, "name = \"ode-ladder\"\nscenes = [\"toy_viscous\"]");
+  const SweepPlan plan = load_sweep(dir.write("s.toml", text));
+  size_t ladder_points = 0;
+  for (const SweepPoint& p : plan.points)
+    if (plan.spec.setups[p.setup_index].name == "ode-ladder") {
+      ++ladder_points;
+      EXPECT_EQ(p.scene.name, "toy_viscous");
+    }
+  EXPECT_EQ(ladder_points, 2u);
+  text = sweep_text();
+  text.replace(text.find("name = \"ode-ladder\""), 19, "name = \"ode-ladder\"\nscenes = [\"toy\", \"nope\"]");
+  const std::string file = dir.write("bad.toml", text);
+  try {
+    load_sweep(file);
+    FAIL() << "accepted an unknown scene";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), file + ": setup[2].scenes[1]: \"nope\" is not the name of a scene of this sweep "
+                                            "(expected one of: toy, toy_viscous)");
+  }
+}
+
+// ---- gates on a boundary --------------------------------------------------------------------
+
+TEST(SweepSearchGate, BoundaryCheckJudgesTheSearchFromRecords) {
+  const SweepSearch s = search(1e-6, 1e-1, 0.05);
+  const std::vector<SweepRecord> records = synthetic_records(s, [](double v) { return v <= 3.7e-3; }, "toy_viscous", 0);
+  BoundaryCheck c;
+  c.name = "ode-step";
+  c.setup = "ode-regime";
+  c.scene = "toy_viscous";
+  c.require = parse_bound_text("max_safe_timestep >= 1e-3");
+  CheckResult r = evaluate_boundary(c, records);
+  EXPECT_TRUE(r.passed) << render_table({r});
+  c.require = parse_bound_text("max_safe_timestep >= 1e-2");
+  r = evaluate_boundary(c, records);
+  EXPECT_FALSE(r.passed);
+  const std::string table = render_table({r});
+  EXPECT_NE(table.find("max_safe_timestep 0.00"), std::string::npos) << table;
+  EXPECT_NE(table.find(" < 0.01 (regime; bracket "), std::string::npos) << table;
+  // A criterion that comes and goes fails unless allowed.
+  const std::vector<SweepRecord> wavy =
+      synthetic_records(s, [](double v) { return v < 3e-5 || (v > 2e-3 && v < 4e-2); }, "toy_viscous", 0);
+  c.require = parse_bound_text("max_safe_timestep >= 1e-5");
+  r = evaluate_boundary(c, wavy);
+  EXPECT_FALSE(r.passed);
+  EXPECT_NE(render_table({r}).find("monotonic"), std::string::npos);
+  c.allow_non_monotonic = true;
+  EXPECT_TRUE(evaluate_boundary(c, wavy).passed);
+  // Nothing safe, or no record of the search: fails.
+  EXPECT_FALSE(evaluate_boundary(c, synthetic_records(s, [](double) { return false; }, "toy_viscous", 0)).passed);
+  c.scene = "toy";
+  EXPECT_FALSE(evaluate_boundary(c, records).passed);
+}
+
+TEST(SweepSearchGate, GateRunsTheSearchAndFailsWhenTheSafeStepShrinks) {
+  TempDir dir;
+  const std::string sweep = kSource + "/harness/sweeps/search-tiny.toml";
+  const std::string gate = dir.write("gate.toml", "[[boundary]]\nname = \"ode-step\"\nsweep = \"" + sweep +
+                                                      "\"\nsetup = \"ode-regime\"\nrequire = \"max_safe_timestep >= 1e-3\"\n"
+                                                      "[[boundary]]\nname = \"ode-step-strict\"\nsweep = \"" + sweep +
+                                                      "\"\nsetup = \"ode-regime\"\nscene = \"toy_viscous\"\n"
+                                                      "require = \"max_safe_timestep >= 0.05\"\n");
+  const fs::path out = dir.path() / "out.txt", err = dir.path() / "err.txt";
+  const ChildExit e = wait_process(spawn_process(
+      {kBinary, "gate", gate, "--boundary-out", (dir.path() / "runs").string(), "--json", (dir.path() / "g.json").string()},
+      out, err));
+  EXPECT_EQ(e.code, 1) << slurp(err);
+  const json j = json::parse(slurp(dir.path() / "g.json"));
+  ASSERT_EQ(j["results"].size(), 2u);
+  EXPECT_TRUE(j["results"][0]["passed"].get<bool>()) << j.dump(2);
+  EXPECT_FALSE(j["results"][1]["passed"].get<bool>()) << j.dump(2);
+  EXPECT_NE(slurp(out).find("ode-step-strict: max_safe_timestep "), std::string::npos) << slurp(out);
+
+  // Bad input: exit 2, the file, the key and the reason.
+  const std::string bad = dir.write("bad.toml", "[[boundary]]\nname = \"x\"\nsweep = \"" + sweep +
+                                                    "\"\nsetup = \"ode-regime\"\nrequire = \"min_safe_timestep >= 1\"\n");
+  const ChildExit b = wait_process(spawn_process({kBinary, "gate", bad}, out, err));
+  EXPECT_EQ(b.code, 2);
+  EXPECT_NE(slurp(err).find(bad + ": boundary[0].require: \"min_safe_timestep\" is not what setup \"ode-regime\" finds "
+                                  "(expected max_safe_timestep"),
+            std::string::npos)
+      << slurp(err);
 }
 
 }  // namespace
