@@ -622,4 +622,68 @@ TEST(SweepSearchGate, GateRunsTheSearchAndFailsWhenTheSafeStepShrinks) {
       << slurp(err);
 }
 
+// ---- shards, merge and MPI through the command ----------------------------------------------
+
+std::string two_search_sweep() {
+  return "description = \"two searches and a ladder\"\n"
+         "scenes = [ { file = \"" + kScenes + "toy_viscous.toml\", duration = 4.6 }, { file = \"" + kScenes +
+         "toy.toml\", duration = 1.0 } ]\n"
+         "[[setup]]\nname = \"ode-regime\"\nengine = \"ode\"\n"
+         "ladder.search = { key = \"engines.ode.timestep\", from = 1e-4, to = 1e-1, criterion = \"regime\" }\n"
+         "[[setup]]\nname = \"bullet-regime\"\nengine = \"bullet\"\n"
+         "ladder.search = { key = \"engines.bullet.timestep\", from = 1e-4, to = 1e-1, criterion = \"regime\" }\n"
+         "[[setup]]\nname = \"ode-ladder\"\nengine = \"ode\"\n"
+         "ladder = { key = \"engines.ode.timestep\", values = [1e-3, 1e-2] }\n";
+}
+
+int run_tippe(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<std::string> argv = {kBinary};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return wait_process(spawn_process(argv, log, log)).code;
+}
+
+TEST(SweepSearchDistributed, ShardsMergedAndMpiRanksGiveTheRecordsOfOneRun) {
+  TempDir dir;
+  const std::string sweep = dir.write("s.toml", two_search_sweep());
+  const fs::path log = dir.path() / "log";
+  const fs::path whole = dir.path() / "whole", merged = dir.path() / "merged";
+  ASSERT_EQ(run_tippe({"sweep", sweep, "--out", whole.string(), "--jobs", "2", "--no-plots"}, log), 0) << slurp(log);
+  const auto want = records_of(whole);
+  // 2 scenes x 2 searches bisected, and the 4 ladder points.
+  EXPECT_GT(want.size(), 2u * 2 * 4 + 4);
+  std::vector<std::string> merge = {"sweep", "--merge"};
+  for (int i = 0; i < 2; ++i) {
+    const fs::path d = dir.path() / ("shard" + std::to_string(i));
+    ASSERT_EQ(run_tippe({"sweep", sweep, "--shard", std::to_string(i) + "/2", "--out", d.string(), "--jobs", "1",
+                         "--no-plots"},
+                        log),
+              0)
+        << slurp(log);
+    // Each search runs whole in one shard: its bisection needs its own records.
+    std::set<std::string> units;
+    for (const SweepRecord& r : read_records((d / "records.jsonl").string()).records)
+      if (r.search) units.insert(r.scene + "/" + r.setup);
+    EXPECT_GE(units.size(), 1u);
+    merge.push_back(d.string());
+  }
+  merge.insert(merge.end(), {"--out", merged.string(), "--no-plots"});
+  ASSERT_EQ(run_tippe(merge, log), 0) << slurp(log);
+  EXPECT_EQ(records_of(merged), want);
+  // The merged directory is finished: the same sweep on it runs nothing.
+  ASSERT_EQ(run_tippe({"sweep", sweep, "--out", merged.string(), "--jobs", "1", "--no-plots"}, log), 0) << slurp(log);
+  EXPECT_NE(slurp(log).find("0 run now"), std::string::npos) << slurp(log);
+#ifdef TIPPE_HAVE_MPI
+  // The coordinator plans each wave and every rank loads the same points.
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+  const fs::path mpi = dir.path() / "mpi";
+  const int code = wait_process(spawn_process({"mpirun", "--oversubscribe", "-np", "3", kBinary, "sweep", sweep, "--out",
+                                               mpi.string(), "--no-plots"},
+                                              log, log))
+                       .code;
+  ASSERT_EQ(code, 0) << slurp(log);
+  EXPECT_EQ(records_of(mpi), want);
+#endif
+}
+
 }  // namespace
