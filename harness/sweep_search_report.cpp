@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "sweep_search.h"
 
@@ -64,8 +65,16 @@ std::vector<ReportPart> boundary_report(const std::vector<SweepRecord>& records)
   std::vector<std::string> scenes;
   std::vector<std::string> lines;
   std::map<std::pair<std::string, std::string>, const SearchBoundary*> at;
-  for (const SearchBoundary& b : bs) {
+  // Rows in setup order (the sweep file's), columns in scene order.
+  std::vector<const SearchBoundary*> by_setup;
+  for (const SearchBoundary& b : bs) by_setup.push_back(&b);
+  std::stable_sort(by_setup.begin(), by_setup.end(), [](const SearchBoundary* a, const SearchBoundary* b) {
+    return std::tie(a->setup_index, a->grid_index, a->scene_index) < std::tie(b->setup_index, b->grid_index, b->scene_index);
+  });
+  for (const SearchBoundary& b : bs)
     if (std::find(scenes.begin(), scenes.end(), b.scene) == scenes.end()) scenes.push_back(b.scene);
+  for (const SearchBoundary* bp : by_setup) {
+    const SearchBoundary& b = *bp;
     const std::string line = line_name(b) + "\n" + b.engine + "\n" + b.quantity + "\n" + b.criterion;
     if (std::find(lines.begin(), lines.end(), line) == lines.end()) lines.push_back(line);
     at.emplace(std::make_pair(line, b.scene), &b);

@@ -1,5 +1,6 @@
 // Running a sweep with boundary searches: the plan grows wave by wave from the records, on threads or over a farm of ranks.
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 
 #include "sweep_search.h"
@@ -20,6 +21,7 @@ SweepOutcome run_search_sweep(SweepPlan plan, const SweepOptions& o, TaskFarm& f
   const fs::path records_file = fs::path(o.out_dir) / "records.jsonl";
   SweepOutcome total;
   bool first = true;
+  size_t waves = 0;
   for (;;) {
     const std::string wave = from_coordinator(farm, [&] {
       // --restart sets the earlier records aside: nothing to replay from.
@@ -47,6 +49,13 @@ SweepOutcome run_search_sweep(SweepPlan plan, const SweepOptions& o, TaskFarm& f
     SweepOptions w = o;
     w.restart = first && o.restart;
     w.report = false;
+    // The first wave (the planned points, and any a resumed search replayed) has the progress
+    // line; a bisection wave is a point per open bracket, announced in one line.
+    if (!first) {
+      w.progress = false;
+      if (o.progress && farm.coordinator())
+        std::fprintf(stderr, "[sweep] search wave %zu: %zu bisection point(s)\n", ++waves, points.size());
+    }
     const SweepOutcome r = run_sweep(plan, w, farm);
     total.ran += r.ran;
     total.partial_bytes_dropped += r.partial_bytes_dropped;
@@ -55,6 +64,7 @@ SweepOutcome run_search_sweep(SweepPlan plan, const SweepOptions& o, TaskFarm& f
   }
   SweepOptions last = o;
   last.restart = false;
+  last.progress = false;
   const SweepOutcome r = run_sweep(plan, last, farm);  // nothing left to run: the report
   total.points = r.points;
   total.skipped = r.points - total.ran;
