@@ -201,7 +201,8 @@ int sweep(const SweepCliOptions& o) {
 Command setup_sweep(CLI::App& app) {
   auto o = std::make_shared<SweepCliOptions>();
   CLI::App* sub = app.add_subcommand(
-      "sweep", "Work-precision sweep: scenes x engine setups x a ladder of settings; records.jsonl and a report");
+      "sweep", "Work-precision sweep: scenes x engine setups x a ladder of settings (or a boundary search along "
+      "one, ladder.search); records.jsonl and a report");
   sub->add_option("sweep", o->sweep, "Sweep file (TOML), e.g. harness/sweeps/default.toml");
   sub->add_option("--out", o->out, "Output directory (default out/<sweep name>-sweep); rerun to resume");
   sub->add_option("--jobs,-j", o->jobs, "Runs in parallel (default: one per core)")->check(CLI::PositiveNumber);
