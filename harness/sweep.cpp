@@ -503,7 +503,13 @@ SweepPlan load_sweep(const std::string& path) {
           try {
             p.scene = load_scene(file, point_over);
           } catch (const SceneError& x) {
-            reader.fail(idx(key + ".ladder.values", k) +
+            // A search's coarse value: its ends are `from` and `to`, the others lie between.
+            const std::string where =
+                !setup.search ? idx(key + ".ladder.values", k)
+                : k == 0      ? key + ".ladder.search.from"
+                : k + 1 == setup.ladder_values.size() ? key + ".ladder.search.to"
+                                                      : key + ".ladder.search (at " + setup.ladder_texts[k] + ")";
+            reader.fail(where +
                             (setup.has_grid() ? " (with " + idx(key + ".grid.values", g) + ")" : std::string()),
                         quote_scene_error(x, file));
           }

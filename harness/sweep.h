@@ -215,7 +215,8 @@ struct SweepRecord {
 nlohmann::json to_json(const SweepRecord& r);
 // Every field checked for its type and range (indices 0 <= i < kMaxSweepPoints, repeats as in a
 // sweep file, counts >= 0, times and costs numbers or null, the class a known name, keys and
-// labels of the axes names (is_valid_name) or numbers, a label equal to its axis' number);
+// labels of the axes names (is_valid_name) or numbers, a label equal to its axis' number, a
+// search null or absent or with the rules of ladder.search);
 // throws SweepRecordError "KEY: reason" for anything else, another format included.
 SweepRecord sweep_record_from_json(const nlohmann::json& j);
 // One line of records.jsonl, '\n' included.

@@ -418,6 +418,11 @@ TEST(SweepSearchInput, BadSearchNamesFileKeyAndReason) {
        "setup[0].ladder.search.to", "decades above from"},
       {"set = [\"engines.ode.timestep=1e-3\"]\nladder.search = { " + ok + " }", "setup[0].ladder.search.key",
        "engines.ode.timestep is also fixed in setup[0].set"},
+      // The engine's own range (timestep <= 0.1) refuses the search's end.
+      {"ladder.search = { key = \"engines.ode.timestep\", from = 1e-4, to = 1, criterion = \"regime\" }",
+       "setup[0].ladder.search.to", "engines.ode.timestep: value 1 outside [1e-08, 0.1]"},
+      {"ladder.search = { key = \"engines.ode.timestepx\", from = 1e-4, to = 1e-1, criterion = \"regime\" }",
+       "setup[0].ladder.search.from", "timestepx"},
   };
   TempDir dir;
   for (const auto& c : cases) {
