@@ -400,6 +400,7 @@ std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& se
     for (const std::string& x : {std::string("search"), q.criterion, json(q.from).dump(), json(q.to).dump(),
                                  json(q.resolution).dump(), std::to_string(q.per_decade)})
       parts.push_back(x);
+    if (q.integer) parts.push_back("integer");
   }
   return fnv1a_hex(parts);
 }
@@ -665,7 +666,8 @@ json search_json(const std::optional<SweepSearch>& q) {
               {"from", q->from},
               {"to", q->to},
               {"resolution", q->resolution},
-              {"per_decade", q->per_decade}};
+              {"per_decade", q->per_decade},
+              {"integer", q->integer}};
 }
 
 // A record's search, with the rules of `ladder.search` in a sweep file (sweep_search.h).
@@ -685,6 +687,13 @@ SweepSearch search_from_json(const json& j) {
     R::fail("search", "not a search's range and resolution (expected 0 < from < to, at most " + num(kMaxSearchDecades) +
                           " decades, resolution <= " + num(kMaxSearchResolution) + ")");
   q.per_decade = static_cast<int>(R::integer(j, "search", "per_decade", 1, kMaxSearchPerDecade));
+  if (j.contains("integer")) {
+    const json& i = j.at("integer");
+    if (!i.is_boolean()) R::fail("search.integer", std::string("expected true or false, got ") + i.type_name());
+    q.integer = i.get<bool>();
+    if (q.integer && (q.from != std::floor(q.from) || q.to != std::floor(q.to)))
+      R::fail("search.integer", "from and to of an integer search are whole numbers");
+  }
   return q;
 }
 

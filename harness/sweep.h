@@ -49,6 +49,9 @@ struct SweepSearch {
   double from = 0, to = 0;  // 0 < from < to, the key's range
   double resolution = 0.05;  // log10 units: bisection stops when the bracket is narrower
   int per_decade = 1;        // coarse grid points per decade
+  // from and to written as integers: every value is a whole number (an iteration count), and a
+  // bracket of two neighbouring integers is as fine as the search gets.
+  bool integer = false;
 };
 
 struct SweepSetup {

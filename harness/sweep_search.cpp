@@ -77,6 +77,7 @@ SweepSearch read_search(const toml::node& node, const std::string& file, const s
   key = string("key");
   s.from = number("from", true, 0);
   s.to = number("to", true, 0);
+  s.integer = t->get("from")->is_integer() && t->get("to")->is_integer();
   if (!(s.from > 0)) fail(where + ".from", num(s.from) + " is out of range (expected from > 0: the search is in log10)");
   if (!(s.to > s.from)) fail(where + ".to", num(s.to) + " is out of range (expected to > from = " + num(s.from) + ")");
   if (std::log10(s.to / s.from) > kMaxSearchDecades)
@@ -129,15 +130,22 @@ double search_round(double v) {
   return std::strtod(buf, nullptr);
 }
 
-std::string search_value_text(double v) { return json(v).dump(); }
+std::string search_value_text(double v) {
+  // A whole number as an integer (an iteration count must be one); 1e15 keeps it exact.
+  if (v == std::floor(v) && std::abs(v) < 1e15) return std::to_string(static_cast<long long>(v));
+  return json(v).dump();
+}
 
 std::vector<double> search_coarse_grid(const SweepSearch& s) {
   const double lf = std::log10(s.from), lt = std::log10(s.to);
   // 1e-9: a range of exactly k decades is k * per_decade steps, not one more.
   const int n = std::max(1, static_cast<int>(std::ceil((lt - lf) * s.per_decade - 1e-9)));
   std::vector<double> v;
-  for (int k = 0; k <= n; ++k)
-    v.push_back(k == 0 ? s.from : k == n ? s.to : search_round(std::pow(10.0, lf + (lt - lf) * k / n)));
+  for (int k = 0; k <= n; ++k) {
+    const double x = std::pow(10.0, lf + (lt - lf) * k / n);
+    const double value = k == 0 ? s.from : k == n ? s.to : s.integer ? std::round(x) : search_round(x);
+    if (v.empty() || value > v.back()) v.push_back(value);  // integers: 1, 2, 2, 3 runs 2 once
+  }
   return v;
 }
 
@@ -166,8 +174,10 @@ SearchReplay replay_search(const SweepSearch& s, const std::function<std::option
     c.hi = r.coarse[k + 1];
     c.lo_passes = *r.coarse_passes[k];
     while (std::log10(c.hi / c.lo) >= s.resolution) {
-      const double mid = search_round(std::pow(10.0, 0.5 * (std::log10(c.lo) + std::log10(c.hi))));
-      if (!(mid > c.lo && mid < c.hi)) break;  // 6 digits cannot split it (resolution >= 1e-3 keeps this away)
+      const double x = std::pow(10.0, 0.5 * (std::log10(c.lo) + std::log10(c.hi)));
+      const double mid = s.integer ? std::round(x) : search_round(x);
+      // Neighbouring integers (or 6 digits, which resolution >= 1e-3 keeps away) cannot be split.
+      if (!(mid > c.lo && mid < c.hi)) break;
       const long long index = n + bracket * kSearchIndexStride + static_cast<long long>(c.steps);
       const std::optional<bool> o = outcome(search_value_text(mid));
       if (!o) {
@@ -178,7 +188,7 @@ SearchReplay replay_search(const SweepSearch& s, const std::function<std::option
       ++c.steps;
       (*o == c.lo_passes ? c.lo : c.hi) = mid;
     }
-    c.resolved = std::log10(c.hi / c.lo) < s.resolution;
+    c.resolved = std::log10(c.hi / c.lo) < s.resolution || (s.integer && c.hi - c.lo <= 1);
     r.crossings.push_back(c);
     ++bracket;
   }

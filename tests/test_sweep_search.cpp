@@ -123,6 +123,44 @@ TEST(SweepSearch, NonMonotonicCriterionHasEveryCrossingBisected) {
   }
 }
 
+TEST(SweepSearch, IntegerSearchStaysOnWholeNumbersAndStopsAtNeighbours) {
+  // An iteration count: the criterion holds from 37 up (fewer iterations are the softer side).
+  SweepSearch s = search(1, 1000, 0.001);
+  s.integer = true;
+  const Synthetic r = run_synthetic(s, [](double v) { return v >= 37; });
+  for (const auto& [text, ok] : r.run) {
+    (void)ok;
+    EXPECT_EQ(text.find_first_not_of("0123456789"), std::string::npos) << text;
+  }
+  ASSERT_EQ(r.replay.crossings.size(), 1u);
+  EXPECT_EQ(r.replay.crossings[0].lo, 36);
+  EXPECT_EQ(r.replay.crossings[0].hi, 37);
+  EXPECT_TRUE(r.replay.crossings[0].resolved);
+  // 4 coarse values, then 10..100 halved in log down to neighbours: a handful of runs.
+  EXPECT_LE(r.run.size(), 4u + 7u);
+  // A coarse grid finer than the integers runs each integer once.
+  s = search(1, 3, 0.05);
+  s.integer = true;
+  s.per_decade = 20;
+  EXPECT_EQ(search_coarse_grid(s), (std::vector<double>{1, 2, 3}));
+}
+
+TEST(SweepSearch, IntegerSearchOfAnIterationCountLoads) {
+  TempDir dir;
+  const SweepPlan plan = load_sweep(dir.write(
+      "i.toml", "scenes = [\"" + kScenes + "toy.toml\"]\n[[setup]]\nname = \"ode-iterations\"\nengine = \"ode\"\n"
+                "ladder.search = { key = \"engines.ode.iterations\", from = 2, to = 200, criterion = \"regime\" }\n"));
+  const SweepSetup& u = plan.spec.setups[0];
+  ASSERT_TRUE(u.search && u.search->integer);
+  EXPECT_EQ(u.ladder_texts, (std::vector<std::string>{"2", "20", "200"}));
+  EXPECT_EQ(boundary_quantity(u.ladder_key), "min_safe_iterations");
+  // Written as floats, the same range is a search over real values.
+  const SweepPlan f = load_sweep(dir.write(
+      "f.toml", "scenes = [\"" + kScenes + "toy.toml\"]\n[[setup]]\nname = \"ode-step\"\nengine = \"ode\"\n"
+                "ladder.search = { key = \"engines.ode.timestep\", from = 1e-3, to = 1e-1, criterion = \"regime\" }\n"));
+  EXPECT_FALSE(f.spec.setups[0].search->integer);
+}
+
 // ---- records and the report's boundaries ----------------------------------------------------
 
 // Records of a synthetic search as a sweep would write them: the regime criterion, the reference
