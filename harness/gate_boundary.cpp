@@ -45,6 +45,8 @@ std::vector<BoundaryCheck> load_boundary_checks(const std::string& gate_path, co
   };
   const auto* arr = bn->as_array();
   if (!arr) fail("boundary", "expected [[boundary]] tables, got " + toml_value_text(*bn));
+  if (arr->empty() && check_names.empty())
+    fail("boundary", "no checks (a gate file needs one or more [[check]] or [[boundary]] tables)");
   std::set<std::string> names(check_names.begin(), check_names.end());
   std::map<std::string, SweepPlan> sweeps;
   const fs::path base = fs::path(gate_path).parent_path();

@@ -103,12 +103,21 @@ TEST(SweepSearchGate, GateRunsTheSearchAndFailsWhenTheSafeStepShrinks) {
   // Bad input: exit 2, the file, the key and the reason.
   const std::string bad = dir.write("bad.toml", "[[boundary]]\nname = \"x\"\nsweep = \"" + sweep +
                                                     "\"\nsetup = \"ode-regime\"\nrequire = \"min_safe_timestep >= 1\"\n");
-  const ChildExit b = wait_process(spawn_process({kBinary, "gate", bad}, out, err));
+  ChildExit b = wait_process(spawn_process({kBinary, "gate", bad}, out, err));
   EXPECT_EQ(b.code, 2);
   EXPECT_NE(slurp(err).find(bad + ": boundary[0].require: \"min_safe_timestep\" is not what setup \"ode-regime\" finds "
                                   "(expected max_safe_timestep"),
             std::string::npos)
       << slurp(err);
+  const std::string empty = dir.write("empty.toml", "boundary = []\n");
+  b = wait_process(spawn_process({kBinary, "gate", empty}, out, err));
+  EXPECT_EQ(b.code, 2);
+  EXPECT_NE(slurp(err).find(empty + ": boundary: no checks"), std::string::npos) << slurp(err);
+  const std::string unknown = dir.write("unknown.toml", "[[boundary]]\nname = \"x\"\nsweep = \"" + sweep +
+                                                            "\"\nsetup = \"nope\"\nrequire = \"max_safe_timestep >= 1\"\n");
+  b = wait_process(spawn_process({kBinary, "gate", unknown}, out, err));
+  EXPECT_EQ(b.code, 2);
+  EXPECT_NE(slurp(err).find(unknown + ": boundary[0].setup: \"nope\" is not a setup of "), std::string::npos) << slurp(err);
 }
 
 // ---- shards, merge and MPI through the command ----------------------------------------------
