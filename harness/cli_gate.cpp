@@ -9,6 +9,8 @@
 #include "cli.h"
 #include "compare.h"
 #include "gate.h"
+#include "gate_boundary.h"
+#include "sweep_search.h"
 #include "output_dir.h"
 #include "records.h"
 #include "scene_io.h"
@@ -24,6 +26,7 @@ struct GateCliOptions {
   std::string junit, json;
   int jobs = 0;  // 0: one per core, at most one per run of a comparison
   std::string cache = "out/.reference-cache";
+  std::string boundary_out = "out/.boundary-runs";
   bool no_cache = false;
   bool no_self_check = false;
 };
@@ -47,6 +50,9 @@ int gate(const GateCliOptions& o) {
   // Everything that can be wrong with the input (gate file, scenes, overrides, engine settings,
   // output paths) is found before the first run.
   const GateFile g = load_gate_file(o.gates);
+  std::vector<std::string> check_names;
+  for (const Check& c : g.checks) check_names.push_back(c.name);
+  const std::vector<BoundaryCheck> boundaries = load_boundary_checks(o.gates, check_names);
   check_output(o.junit, "--junit");
   check_output(o.json, "--json");
   std::error_code ec;
@@ -106,6 +112,29 @@ int gate(const GateCliOptions& o) {
     }
   }
 
+  // Boundary checks: each sweep they name runs once, from scratch (records of an earlier build
+  // must not stand in for this one's), into its own directory under --boundary-out.
+  std::map<std::string, std::vector<SweepRecord>> sweep_records;
+  for (const BoundaryCheck& b : boundaries) {
+    if (sweep_records.count(b.sweep_path)) continue;
+    std::vector<SweepRecord>& records = sweep_records[b.sweep_path];
+    try {
+      const SweepPlan plan = load_sweep(b.sweep_path);
+      SweepOptions so;
+      so.out_dir = (fs::path(o.boundary_out) / (fs::path(b.sweep_path).stem().string() + "-" + plan.spec.hash)).string();
+      so.jobs = o.jobs > 0 ? o.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+      so.restart = true;
+      so.plots = false;
+      std::fprintf(stderr, "gate %s: boundary search %s into %s\n", o.gates.c_str(), b.sweep_path.c_str(),
+                   so.out_dir.c_str());
+      run_search_sweep(plan, so);
+      records = read_records((fs::path(so.out_dir) / "records.jsonl").string()).records;
+    } catch (const SweepInputError& e) {
+      throw UsageError(e.what());
+    }
+  }
+  for (const BoundaryCheck& b : boundaries) results.push_back(evaluate_boundary(b, sweep_records[b.sweep_path]));
+
   // With a report on stdout (-), stdout holds that report alone and the table goes to stderr.
   const bool report_on_stdout = o.junit == "-" || o.json == "-";
   std::fprintf(report_on_stdout ? stderr : stdout, "%s", render_table(results).c_str());
@@ -136,6 +165,8 @@ Command setup_gate(CLI::App& app) {
   sub->add_option("--jobs,-j", o->jobs, "Runs in parallel within a comparison (default: one per core)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--cache", o->cache, "Reference cache directory")->capture_default_str();
+  sub->add_option("--boundary-out", o->boundary_out, "Directory of the sweeps that [[boundary]] checks run")
+      ->capture_default_str();
   sub->add_flag("--no-cache", o->no_cache, "Always run the reference; leave the cache alone");
   sub->add_flag("--no-self-check", o->no_self_check,
                 "Skip the reference's self-check: metrics are then compared over the whole run unchecked");

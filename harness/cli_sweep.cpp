@@ -8,6 +8,7 @@
 
 #include "cli.h"
 #include "mpi_farm.h"
+#include "sweep_search.h"
 #include "scene_io.h"
 #include "sweep.h"
 
@@ -109,7 +110,7 @@ int run_local(const SweepCliOptions& o) {
   const SweepPlan plan = load_sweep(o.sweep);
   SweepOutcome r;
   try {
-    r = run_sweep(plan, opts);
+    r = run_search_sweep(plan, opts);
   } catch (const SweepInputError& e) {
     throw UsageError(e.what());
   }
@@ -151,7 +152,7 @@ int run_mpi(const SweepCliOptions& o, const MpiSession& mpi) {
   if (!verdict.empty()) throw UsageError(verdict);
   SweepOutcome r;
   try {
-    r = run_sweep(*plan, opts, *farm);
+    r = run_search_sweep(*plan, opts, *farm);
   } catch (const SweepInputError& e) {
     throw UsageError(e.what());
   }
@@ -200,7 +201,8 @@ int sweep(const SweepCliOptions& o) {
 Command setup_sweep(CLI::App& app) {
   auto o = std::make_shared<SweepCliOptions>();
   CLI::App* sub = app.add_subcommand(
-      "sweep", "Work-precision sweep: scenes x engine setups x a ladder of settings; records.jsonl and a report");
+      "sweep", "Work-precision sweep: scenes x engine setups x a ladder of settings (or a boundary search along "
+      "one, ladder.search); records.jsonl and a report");
   sub->add_option("sweep", o->sweep, "Sweep file (TOML), e.g. harness/sweeps/default.toml");
   sub->add_option("--out", o->out, "Output directory (default out/<sweep name>-sweep); rerun to resume");
   sub->add_option("--jobs,-j", o->jobs, "Runs in parallel (default: one per core)")->check(CLI::PositiveNumber);

@@ -209,17 +209,9 @@ class GateReader {
       for (auto&& [k, v] : *m) {
         const std::string metric(k.str());
         const std::string mk = key + ".max." + metric;
-        if (metric == "wall_seconds" || metric == "cpu_seconds" || metric == "real_time_factor")
-          fail(mk, "timing is never gated (it depends on the machine and its load); bound steps or cost_ratio");
-        if (!find_gate_metric(metric)) {
-          std::vector<std::string> names;
-          for (const auto& g : gate_metrics()) names.emplace_back(g.name);
-          fail(mk, "unknown metric (expected one of: " + join(names, ", ") + ")");
-        }
+        if (const std::string why = gate_metric_problem(metric); !why.empty()) fail(mk, why);
         const double x = number(v, mk);
-        // No upper bound: metrics differ in unit and scale (steps, seconds, ratios), and a loose
-        // threshold is a visible choice of the gate's author, not a typo that hides a failure.
-        if (x < 0) out_of_range(mk, x, metric + " >= 0: |value| is compared");
+        if (const std::string why = threshold_problem(metric, x); !why.empty()) fail(mk, why);
         s.max[metric] = x;
       }
     }
@@ -282,6 +274,53 @@ const GateMetric* find_gate_metric(const std::string& name) {
   return nullptr;
 }
 
+std::string gate_metric_problem(const std::string& metric) {
+  if (metric == "wall_seconds" || metric == "cpu_seconds" || metric == "real_time_factor")
+    return "timing is never gated (it depends on the machine and its load); bound steps or cost_ratio";
+  if (!find_gate_metric(metric)) {
+    std::vector<std::string> names;
+    for (const auto& g : gate_metrics()) names.emplace_back(g.name);
+    return "unknown metric (expected one of: " + join(names, ", ") + ")";
+  }
+  return {};
+}
+
+std::string threshold_problem(const std::string& metric, double x) {
+  // No upper bound: metrics differ in unit and scale (steps, seconds, ratios), and a loose
+  // threshold is a visible choice of the gate's author, not a typo that hides a failure.
+  if (!(x >= 0)) return fmt(x) + " is out of range (expected " + metric + " >= 0: |value| is compared)";
+  return {};
+}
+
+BoundText parse_bound_text(const std::string& text) {
+  const size_t le = text.find("<="), ge = text.find(">=");
+  if ((le == std::string::npos) == (ge == std::string::npos))
+    throw std::invalid_argument("\"" + utf8_replaced(text.substr(0, 80)) +
+                                "\" is not a bound (expected NAME <= NUMBER or NAME >= NUMBER)");
+  const size_t at = le != std::string::npos ? le : ge;
+  BoundText b;
+  b.name = trim(text.substr(0, at));
+  b.op = text.substr(at, 2);
+  const std::string value = trim(text.substr(at + 2));
+  if (b.name.empty()) throw std::invalid_argument("\"" + utf8_replaced(text.substr(0, 80)) + "\": no name before " + b.op);
+  char* end = nullptr;
+  errno = 0;
+  b.bound = value.empty() ? 0.0 : std::strtod(value.c_str(), &end);
+  if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(b.bound) ||
+      value.find_first_not_of("0123456789+-.eE") != std::string::npos)
+    throw std::invalid_argument("\"" + utf8_replaced(value.substr(0, 40)) + "\" after " + b.op +
+                                " is not a finite number");
+  return b;
+}
+
+Threshold parse_threshold_text(const std::string& text) {
+  const BoundText b = parse_bound_text(text);
+  if (b.op != "<=") throw std::invalid_argument("a metric is bounded from above: " + b.name + " <= NUMBER (|value| is compared)");
+  if (const std::string why = gate_metric_problem(b.name); !why.empty()) throw std::invalid_argument(b.name + ": " + why);
+  if (const std::string why = threshold_problem(b.name, b.bound); !why.empty()) throw std::invalid_argument(why);
+  return Threshold{b.name, b.bound};
+}
+
 // ---- gate files -----------------------------------------------------------------------------
 
 GateFile load_gate_file(const std::string& path) {
@@ -302,7 +341,8 @@ GateFile load_gate_file(const std::string& path) {
                      std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
   }
 
-  reader.keys(root, "", {"defaults", "check"});
+  // [[boundary]] checks bound a sweep's boundary search instead (gate_boundary.h).
+  reader.keys(root, "", {"defaults", "check", "boundary"});
   Spec defaults;
   defaults.key = "defaults";
   if (const toml::node* d = root.get("defaults")) {
@@ -311,7 +351,12 @@ GateFile load_gate_file(const std::string& path) {
     defaults = reader.spec(*t, "defaults", true);
   }
   const toml::node* cn = root.get("check");
-  if (!cn) reader.fail("check", "no checks (a gate file needs one or more [[check]] tables)");
+  if (!cn && root.get("boundary")) {
+    GateFile only_boundaries;
+    only_boundaries.file = path;
+    return only_boundaries;
+  }
+  if (!cn) reader.fail("check", "no checks (a gate file needs one or more [[check]] or [[boundary]] tables)");
   const auto* checks = cn->as_array();
   if (!checks) reader.fail("check", "expected [[check]] tables, got " + toml_value_text(*cn));
   if (checks->empty()) reader.fail("check", "no checks (a gate file needs one or more [[check]] tables)");
@@ -471,6 +516,8 @@ GateRow event_row(const std::string& metric, const std::string& which, const cha
   return r;
 }
 
+}  // namespace
+
 GateRow threshold_row(const Threshold& t, const Metrics& m) {
   GateRow r;
   r.kind = GateRowKind::Threshold;
@@ -495,6 +542,8 @@ GateRow threshold_row(const Threshold& t, const Metrics& m) {
   }
   return r;
 }
+
+namespace {
 
 // Metrics computed over the samples the reference and the engine have in common: cut at the end
 // of the reference's converged window.

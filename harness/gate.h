@@ -35,6 +35,23 @@ struct Threshold {
   double max = 0;      // |value| <= max passes
 };
 
+// ---- bounds as text ---------------------------------------------------------------------------
+
+// "" when `metric` may be gated (a gate metric, not a timing), else the reason.
+std::string gate_metric_problem(const std::string& metric);
+// "" when `x` is a usable threshold of `metric` (>= 0: |value| is compared), else the reason.
+std::string threshold_problem(const std::string& metric, double x);
+// One bound written as text, "NAME <= NUMBER" or "NAME >= NUMBER" (blanks around either part);
+// throws std::invalid_argument with the reason (the caller names the file and key).
+struct BoundText {
+  std::string name, op;  // op: "<=" or ">="
+  double bound = 0;
+};
+BoundText parse_bound_text(const std::string& text);
+// A [check.max] entry as text, "METRIC <= NUMBER", with that entry's rules (a sweep's boundary
+// search criterion is one); throws std::invalid_argument with the reason.
+Threshold parse_threshold_text(const std::string& text);
+
 struct Check {
   std::string name;
   std::string scene;       // as written in the gate file
@@ -109,6 +126,8 @@ struct CheckResult {
 // than its author asked for would be weaker than it reads: shorten the duration or allow it.
 CheckResult evaluate_check(const Check& check, const RunRecord& reference, const RunRecord& engine,
                            const Metrics& metrics);
+// One threshold row on `m`: passes when |value| <= max; absent or NaN fails with the reason.
+GateRow threshold_row(const Threshold& t, const Metrics& m);
 // A check whose comparison could not be run (the reference failed, an output error): it fails
 // with one "run" row carrying `why`.
 CheckResult error_result(const Check& check, const std::string& why);

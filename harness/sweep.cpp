@@ -36,6 +36,7 @@
 #include "provenance.h"
 #include "records.h"
 #include "scene_io.h"
+#include "sweep_search.h"
 #include "toml_text.h"
 #include "timing.h"
 
@@ -248,7 +249,7 @@ class SweepReader {
     for (size_t i = 0; i < setups.size(); ++i) {
       const std::string key = idx("setup", i);
       const toml::table& t = table(*setups.get(i), key);
-      keys(t, key, {"name", "engine", "set", "ladder", "grid"});
+      keys(t, key, {"name", "engine", "set", "ladder", "grid", "scenes"});
       SweepSetup u;
       const toml::node* name = t.get("name");
       if (!name) fail(key + ".name", "missing (required)");
@@ -280,10 +281,39 @@ class SweepReader {
           u.set.push_back(o);
         }
       }
+      if (const toml::node* only = t.get("scenes")) {
+        // Names, checked against the scenes' once they are loaded (load_sweep).
+        const toml::array& a = array(*only, key + ".scenes");
+        if (a.empty()) fail(key + ".scenes", "must name at least one scene (leave it out for every scene)");
+        for (size_t j = 0; j < a.size(); ++j) {
+          const std::string n = string(*a.get(j), idx(key + ".scenes", j));
+          if (std::find(u.only_scenes.begin(), u.only_scenes.end(), n) != u.only_scenes.end())
+            fail(idx(key + ".scenes", j), "\"" + utf8_replaced(n.substr(0, 40)) + "\" is listed twice");
+          u.only_scenes.push_back(n);
+        }
+      }
       const toml::node* ladder = t.get("ladder");
       if (!ladder) fail(key + ".ladder", "missing (required: {key = \"...\", values = [...]})");
-      read_axis(*ladder, key + ".ladder", u.engine, set_keys, u.ladder_key, u.ladder_values, u.ladder_texts,
-                u.ladder_labels, s.scenes.size(), 1, planned);
+      if (const auto* lt = ladder->as_table(); lt && lt->get("search")) {
+        // A boundary search (sweep_search.h): its coarse grid is the ladder planned up front.
+        keys(*lt, key + ".ladder", {"search"});
+        u.search = read_search(*lt->get("search"), file_, key + ".ladder.search", u.ladder_key);
+        check_setting_key(u.engine, u.ladder_key, key + ".ladder.search.key");
+        if (set_keys.count(u.ladder_key))
+          fail(key + ".ladder.search.key", u.ladder_key + " is also fixed in " + key + ".set");
+        for (double v : search_coarse_grid(*u.search)) {
+          u.ladder_values.push_back(v);
+          u.ladder_texts.push_back(search_value_text(v));
+          u.ladder_labels.push_back(search_value_text(v));
+        }
+        planned += u.ladder_values.size();
+        if (s.scenes.size() * planned > kMaxSweepPoints)
+          fail(key + ".ladder.search", "its coarse grid makes more than " + std::to_string(kMaxSweepPoints) +
+                                           " points, the most a sweep plans");
+      } else {
+        read_axis(*ladder, key + ".ladder", u.engine, set_keys, u.ladder_key, u.ladder_values, u.ladder_texts,
+                  u.ladder_labels, s.scenes.size(), 1, planned);
+      }
       if (const toml::node* grid = t.get("grid")) {
         // Each grid value beyond the first adds the ladder's points again.
         planned -= u.ladder_values.size();
@@ -366,6 +396,13 @@ std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& se
     parts.push_back(setup.grid_key);
     parts.push_back(grid_value_text);
   }
+  if (setup.search) {
+    const SweepSearch& q = *setup.search;
+    for (const std::string& x : {std::string("search"), q.criterion, json(q.from).dump(), json(q.to).dump(),
+                                 json(q.resolution).dump(), std::to_string(q.per_decade)})
+      parts.push_back(x);
+    if (q.integer) parts.push_back("integer");
+  }
   return fnv1a_hex(parts);
 }
 
@@ -418,11 +455,20 @@ SweepPlan load_sweep(const std::string& path) {
     scene_overrides.push_back(over);
   }
 
+  for (size_t u = 0; u < s.setups.size(); ++u)
+    for (size_t j = 0; j < s.setups[u].only_scenes.size(); ++j)
+      if (!scene_names.count(s.setups[u].only_scenes[j])) {
+        std::string list;
+        for (const auto& [n, k] : scene_names) list += (list.empty() ? "" : ", ") + n;
+        reader.fail(idx(idx("setup", u) + ".scenes", j), "\"" + utf8_replaced(s.setups[u].only_scenes[j].substr(0, 40)) +
+                                                             "\" is not the name of a scene of this sweep (expected one of: " + list + ")");
+      }
   std::vector<std::string> ids;
   for (size_t i = 0; i < s.scenes.size(); ++i) {
     const std::string& file = s.scenes[i].path;
     for (size_t u = 0; u < s.setups.size(); ++u) {
       const SweepSetup& setup = s.setups[u];
+      if (!setup.runs_on(plan.scenes[i].name)) continue;
       const std::string key = idx("setup", u);
       std::vector<std::string> over = scene_overrides[i];
       over.insert(over.end(), setup.set.begin(), setup.set.end());
@@ -453,10 +499,19 @@ SweepPlan load_sweep(const std::string& path) {
           p.setup_index = u;
           p.ladder_index = k;
           p.grid_index = g;
+          p.ladder_value = setup.ladder_values[k];
+          p.ladder_text = setup.ladder_texts[k];
+          p.ladder_label = setup.ladder_labels[k];
           try {
             p.scene = load_scene(file, point_over);
           } catch (const SceneError& x) {
-            reader.fail(idx(key + ".ladder.values", k) +
+            // A search's coarse value: its ends are `from` and `to`, the others lie between.
+            const std::string where =
+                !setup.search ? idx(key + ".ladder.values", k)
+                : k == 0      ? key + ".ladder.search.from"
+                : k + 1 == setup.ladder_values.size() ? key + ".ladder.search.to"
+                                                      : key + ".ladder.search (at " + setup.ladder_texts[k] + ")";
+            reader.fail(where +
                             (setup.has_grid() ? " (with " + idx(key + ".grid.values", g) + ")" : std::string()),
                         quote_scene_error(x, file));
           }
@@ -470,6 +525,8 @@ SweepPlan load_sweep(const std::string& path) {
     }
   }
   plan.plan_hash = fnv1a_hex(ids);
+  plan.planned = plan.points.size();
+  plan.scene_overrides = scene_overrides;
   return plan;
 }
 
@@ -604,6 +661,43 @@ std::string class_of_status(const std::string& status) {
   return "failed";
 }
 
+json search_json(const std::optional<SweepSearch>& q) {
+  if (!q) return nullptr;
+  return json{{"criterion", q->criterion},
+              {"from", q->from},
+              {"to", q->to},
+              {"resolution", q->resolution},
+              {"per_decade", q->per_decade},
+              {"integer", q->integer}};
+}
+
+// A record's search, with the rules of `ladder.search` in a sweep file (sweep_search.h).
+SweepSearch search_from_json(const json& j) {
+  using R = RecordReader;
+  SweepSearch q;
+  q.criterion = R::string(j, "search", "criterion");
+  try {
+    parse_criterion(q.criterion);
+  } catch (const std::invalid_argument& e) {
+    R::fail("search.criterion", e.what());
+  }
+  q.from = R::number(j, "search", "from", std::numeric_limits<double>::min());
+  q.to = R::number(j, "search", "to", q.from);
+  q.resolution = R::number(j, "search", "resolution", kMinSearchResolution);
+  if (!(q.to > q.from) || !(q.resolution <= kMaxSearchResolution) || std::log10(q.to / q.from) > kMaxSearchDecades)
+    R::fail("search", "not a search's range and resolution (expected 0 < from < to, at most " + num(kMaxSearchDecades) +
+                          " decades, resolution <= " + num(kMaxSearchResolution) + ")");
+  q.per_decade = static_cast<int>(R::integer(j, "search", "per_decade", 1, kMaxSearchPerDecade));
+  if (j.contains("integer")) {
+    const json& i = j.at("integer");
+    if (!i.is_boolean()) R::fail("search.integer", std::string("expected true or false, got ") + i.type_name());
+    q.integer = i.get<bool>();
+    if (q.integer && (q.from != std::floor(q.from) || q.to != std::floor(q.to)))
+      R::fail("search.integer", "from and to of an integer search are whole numbers");
+  }
+  return q;
+}
+
 }  // namespace
 
 json to_json(const SweepRecord& r) {
@@ -652,6 +746,7 @@ json to_json(const SweepRecord& r) {
       {"settings", r.settings},
       {"class", {{"name", r.run_class}, {"time", number(r.class_time)}, {"reason", r.class_reason}}},
       {"reference", reference_json(r.reference)},
+      {"search", search_json(r.search)},
   };
 }
 
@@ -758,6 +853,7 @@ SweepRecord sweep_record_from_json(const json& j) {
     f.final_tilt = R::number(x, "reference", "final_tilt");
     r.reference = f;
   }
+  if (j.contains("search") && !j.at("search").is_null()) r.search = search_from_json(j.at("search"));
   return r;
 }
 
@@ -1023,8 +1119,9 @@ SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Referenc
   r.engine = setup.engine;
   r.set = setup.set;
   r.ladder_key = setup.ladder_key;
-  r.ladder_value = setup.ladder_values[p.ladder_index];
-  r.ladder_label = setup.ladder_labels[p.ladder_index];
+  r.ladder_value = p.ladder_value;
+  r.ladder_label = p.ladder_label;
+  r.search = setup.search;
   r.setup_index = static_cast<long long>(p.setup_index);
   r.ladder_index = static_cast<long long>(p.ladder_index);
   if (setup.has_grid()) {
@@ -1110,7 +1207,7 @@ double point_weight(const SweepPlan& plan, const SweepPoint& p) {
     return k.size() >= 8 && k.compare(k.size() - 8, 8, "timestep") == 0;
   };
   // The time step may be either axis of a grid.
-  double v = is_step(s.ladder_key) ? s.ladder_values[p.ladder_index] : std::nan("");
+  double v = is_step(s.ladder_key) ? p.ladder_value : std::nan("");
   if (s.has_grid() && is_step(s.grid_key)) v = s.grid_values[p.grid_index];
   const double per_time = v > 0 ? 1.0 / v : (s.engine == "analytic" ? 100.0 : 1e4);
   return plan.spec.repeats * p.scene.run.duration * per_time;
@@ -1288,7 +1385,9 @@ class RecordAppender {
 json shard_json(const SweepPlan& plan, const std::optional<SweepShard>& shard, const std::vector<size_t>& share) {
   if (!shard) return nullptr;
   json ids = json::array();
-  for (size_t i : share) ids.push_back(plan.points[i].id);
+  // The points planned up front: a boundary search's later points follow their search's shard.
+  for (size_t i : share)
+    if (i < plan.planned) ids.push_back(plan.points[i].id);
   return json{{"index", shard->index}, {"count", shard->count}, {"point_ids", ids}};
 }
 
@@ -1303,7 +1402,7 @@ json sweep_json(const SweepPlan& plan, const json& shard) {
               {"plan_hash", plan.plan_hash},
               {"description", plan.spec.description},
               {"repeats", plan.spec.repeats},
-              {"points", plan.points.size()},
+              {"points", plan.planned},
               {"scenes", scenes},
               {"setups", setups},
               {"sweep_text", plan.spec.text},
@@ -1490,8 +1589,8 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<O
   return p;
 }
 
-// Runs `make` on the coordinator and gives its result to every rank. When it throws, every rank
-// throws the same: a SweepInputError as one, anything else as std::runtime_error with its text.
+}  // namespace
+
 std::string from_coordinator(TaskFarm& farm, const std::function<std::string()>& make) {
   std::string message;
   if (farm.coordinator()) {
@@ -1515,8 +1614,6 @@ std::string from_coordinator(TaskFarm& farm, const std::function<std::string()>&
   return message;
 }
 
-}  // namespace
-
 SweepShard parse_shard(const std::string& text) {
   const size_t slash = text.find('/');
   auto number = [&](const std::string& part, long long& v) {
@@ -1536,19 +1633,33 @@ std::vector<size_t> shard_points(const SweepPlan& plan, const SweepShard& shard)
   // Longest processing time first: the points by a priori weight, heaviest first (ties in plan
   // order), each to the shard with the least weight so far (ties to the lowest shard). A pure
   // function of the plan, so every job of an array computes the same partition.
-  std::vector<size_t> byweight(plan.points.size());
+  // A boundary search is one unit (its later points depend on its earlier records, so they
+  // must be in one shard), weighed by its points planned up front; any other point is its own.
+  std::vector<size_t> unit_of(plan.points.size());
+  std::map<std::tuple<size_t, size_t, size_t>, size_t> search_unit;
+  std::vector<double> w;
+  for (size_t i = 0; i < plan.points.size(); ++i) {
+    const SweepPoint& p = plan.points[i];
+    size_t u = w.size();
+    if (plan.spec.setups[p.setup_index].search)
+      u = search_unit.emplace(std::make_tuple(p.scene_index, p.setup_index, p.grid_index), w.size()).first->second;
+    if (u == w.size()) w.push_back(0.0);
+    unit_of[i] = u;
+    if (i < plan.planned) w[u] += point_weight(plan, p);
+  }
+  std::vector<size_t> byweight(w.size());
   for (size_t i = 0; i < byweight.size(); ++i) byweight[i] = i;
-  std::vector<double> w(plan.points.size());
-  for (size_t i = 0; i < w.size(); ++i) w[i] = point_weight(plan, plan.points[i]);
   std::stable_sort(byweight.begin(), byweight.end(), [&](size_t a, size_t b) { return w[a] > w[b]; });
   std::vector<double> load(static_cast<size_t>(shard.count), 0.0);
-  std::vector<size_t> mine;
-  for (size_t i : byweight) {
+  std::vector<bool> unit_mine(w.size(), false);
+  for (size_t u : byweight) {
     const size_t s = static_cast<size_t>(std::min_element(load.begin(), load.end()) - load.begin());
-    load[s] += w[i];
-    if (s == static_cast<size_t>(shard.index)) mine.push_back(i);
+    load[s] += w[u];
+    unit_mine[u] = s == static_cast<size_t>(shard.index);
   }
-  std::sort(mine.begin(), mine.end());
+  std::vector<size_t> mine;
+  for (size_t i = 0; i < plan.points.size(); ++i)
+    if (unit_mine[unit_of[i]]) mine.push_back(i);
   return mine;
 }
 
@@ -1667,7 +1778,7 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
   outcome.ran = prep.todo.size();
   outcome.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  if (farm.coordinator()) {
+  if (farm.coordinator() && o.report) {
     // The report's files change as one unit: an interrupted rerun of a finished sweep leaves the old report.
     const InterruptGuard guard;
     const std::vector<SweepRecord> records = read_records(records_file.string()).records;

@@ -1,8 +1,10 @@
 // Work-precision sweeps: sweep files, their points, resumable runs into records.jsonl, and the report's analysis.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -39,6 +41,19 @@ struct SweepScene {
 // Values of either axis are all numbers, all strings or all booleans (a categorical axis:
 // `values = ["com", "ball_centre"]`); strings follow the rule of names (is_valid_name), since
 // they become report labels.
+// `ladder.search`: instead of fixed values, the boundary of a criterion along the ladder's key,
+// bracketed on a coarse log grid and bisected in log space (sweep_search.h). Records carry it so
+// that the report and gates find each search's points from the records alone.
+struct SweepSearch {
+  std::string criterion;  // "regime" or "METRIC <= BOUND" (a gate metric), trimmed
+  double from = 0, to = 0;  // 0 < from < to, the key's range
+  double resolution = 0.05;  // log10 units: bisection stops when the bracket is narrower
+  int per_decade = 1;        // coarse grid points per decade
+  // from and to written as integers: every value is a whole number (an iteration count), and a
+  // bracket of two neighbouring integers is as fine as the search gets.
+  bool integer = false;
+};
+
 struct SweepSetup {
   std::string name, engine;
   std::vector<std::string> set;  // "KEY=VALUE" overrides, as written
@@ -50,6 +65,16 @@ struct SweepSetup {
   std::vector<double> grid_values;         // as the ladder's
   std::vector<std::string> grid_texts, grid_labels;
   bool has_grid() const { return !grid_key.empty(); }
+  // A boundary search: ladder_values are its coarse grid (the points planned up front); the
+  // bisection's points come in waves (sweep_search.h), each with its own value.
+  std::optional<SweepSearch> search;
+  // `scenes = ["toy_viscous", ...]`: the names of the sweep's scenes this setup runs on (empty:
+  // every scene), for a setup that means nothing on some (an inversion-time criterion where the
+  // reference does not invert).
+  std::vector<std::string> only_scenes;
+  bool runs_on(const std::string& scene) const {
+    return only_scenes.empty() || std::find(only_scenes.begin(), only_scenes.end(), scene) != only_scenes.end();
+  }
   // Points of this setup: ladder values times grid values (1 without a grid).
   size_t point_count() const { return ladder_values.size() * (has_grid() ? grid_values.size() : 1); }
 };
@@ -69,6 +94,9 @@ struct SweepSpec {
 struct SweepPoint {
   size_t scene_index = 0, setup_index = 0, ladder_index = 0;
   size_t grid_index = 0;  // 0 without a grid
+  // The ladder value run: the setup's ladder_values[ladder_index], or a search's bisection value.
+  double ladder_value = 0;
+  std::string ladder_text, ladder_label;
   std::string id;  // sweep_point_id(...)
   Scene scene;     // as run (every override applied)
 };
@@ -80,6 +108,10 @@ struct SweepPlan {
   std::vector<std::string> physics_hashes;  // physics_hash of each of those
   std::vector<SweepPoint> points;           // scene-major, then setup, then grid, then ladder order
   std::string plan_hash;                    // hash over the point ids: changes when any scene's physics does
+  // The points known up front (the first `planned` of `points`): a boundary search adds its
+  // bisection points after them as its records come in (extend_search_plan, sweep_search.h).
+  size_t planned = 0;
+  std::vector<std::vector<std::string>> scene_overrides;  // each scene's own overrides (its duration)
 };
 
 // Reads and checks a sweep file and every point it expands to. Throws SceneError
@@ -95,7 +127,10 @@ struct SweepPlan {
 //    is_valid_name, or all booleans), grid = {key, values} (optional, the same rules; its key
 //    other than the ladder's). A setup may only touch its engine's settings (engines.ENGINE.*)
 //    or, for the analytic model, run.rtol, run.atol and run.method: a sweep never changes the
-//    physics. Neither axis' key may also be in `set`.
+//    physics. Neither axis' key may also be in `set`. Instead of values, the ladder may be a
+//    boundary search, ladder.search = {key, from, to, criterion, resolution, per_decade}
+//    (read_search, sweep_search.h). scenes (optional): names of the sweep's scenes the setup runs
+//    on, each once (default: every scene).
 //  - every scene with every setup, ladder and grid value must load (the scene's checks and
 //    validate_engine_settings: a value the engine setting refuses, "pyramid" for a cone, is
 //    refused here); the scene's message is quoted after the sweep key
@@ -107,6 +142,7 @@ std::string fnv1a_hex(const std::vector<std::string>& parts);
 // Stable id of a point: hash of the scene's physics, the setup (name, engine, overrides, key),
 // the ladder value's text and the repeats; with a grid, then its key and the grid value's text
 // (a one-axis point's id is what it was before grids existed: published directories resume).
+// A search's id also hashes the search (criterion, range, resolution, grid density).
 std::string sweep_point_id(const std::string& physics_hash, const SweepSetup& setup, const std::string& value_text,
                            int repeats, const std::string& grid_value_text = "");
 
@@ -177,11 +213,13 @@ struct SweepRecord {
     double energy_initial = 0, energy_final = 0, jellett_max_relative_drift = 0, final_tilt = 0;
   };
   std::optional<ReferenceRun> reference;  // absent in records written before it existed
+  std::optional<SweepSearch> search;      // the point's boundary search ("search": null without one)
 };
 nlohmann::json to_json(const SweepRecord& r);
 // Every field checked for its type and range (indices 0 <= i < kMaxSweepPoints, repeats as in a
 // sweep file, counts >= 0, times and costs numbers or null, the class a known name, keys and
-// labels of the axes names (is_valid_name) or numbers, a label equal to its axis' number);
+// labels of the axes names (is_valid_name) or numbers, a label equal to its axis' number, a
+// search null or absent or with the rules of ladder.search);
 // throws SweepRecordError "KEY: reason" for anything else, another format included.
 SweepRecord sweep_record_from_json(const nlohmann::json& j);
 // One line of records.jsonl, '\n' included.
@@ -242,6 +280,7 @@ struct SweepOptions {
   bool restart = false;  // a DIR started with another sweep file (or other scene physics) is begun again
   bool progress = true;  // progress line with the time left on stderr
   bool plots = true;     // gnuplot SVGs in the report
+  bool report = true;    // false: records only (a boundary search's waves write the report once, at the end)
 };
 
 
@@ -263,6 +302,10 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& options);
 // every rank; the points are handed out one at a time. options.jobs is not used. Records are those
 // of a local run (apart from timings and order).
 SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& options, TaskFarm& farm);
+
+// Runs `make` on the coordinator and gives its result to every rank. When it throws, every rank
+// throws the same: a SweepInputError as one, anything else as std::runtime_error with its text.
+std::string from_coordinator(TaskFarm& farm, const std::function<std::string()>& make);
 
 // `tippe sweep --merge`: shard directories of one sweep into one directory, as if run whole:
 // sweep.json without a shard, records.jsonl in plan order, the references, the report. Refuses

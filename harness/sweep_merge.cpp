@@ -115,13 +115,27 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
 
   // Each shard holds exactly its own points, each once: nothing lost, nothing twice.
   std::set<std::string> all_ids;
+  size_t search_points = 0;  // of those, boundary searches' points beyond the planned ones
   std::vector<const SweepRecord*> merged;
   MergeOutcome outcome;
   std::set<std::string> commits;
   for (const ShardDir& s : shards) {
     const std::set<std::string> own(s.ids.begin(), s.ids.end());
-    std::set<std::string> seen;
+    // A boundary search's points beyond its coarse grid are planned from its records: they belong
+    // to the shard that holds the search's planned points.
+    std::set<std::tuple<long long, long long, long long>> own_searches;
+    for (const SweepRecord& r : s.records)
+      if (r.search && own.count(r.point_id)) own_searches.emplace(r.scene_index, r.setup_index, r.grid_index);
+    std::set<std::string> seen, searched;
     for (const SweepRecord& r : s.records) {
+      if (!own.count(r.point_id) && r.search && own_searches.count({r.scene_index, r.setup_index, r.grid_index})) {
+        if (!searched.insert(r.point_id).second) continue;
+        if (!all_ids.insert(r.point_id).second) refuse(s.dir.string() + ": point " + r.point_id + " is also in another shard");
+        merged.push_back(&r);
+        commits.insert(r.git_commit);
+        ++search_points;
+        continue;
+      }
       if (!own.count(r.point_id))
         refuse((s.dir / "records.jsonl").string() + ": point " + r.point_id + " (" + r.scene + ", " + r.setup + ", " +
                r.ladder_key + " = " + ladder_text(r) +
@@ -137,7 +151,7 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
     for (const std::string& id : own)
       if (!all_ids.insert(id).second) refuse(s.dir.string() + ": point " + id + " is also in another shard");
   }
-  if (all_ids.size() != first.points)
+  if (all_ids.size() - search_points != first.points)
     refuse("the shards hold " + std::to_string(all_ids.size()) + " points, the sweep has " +
            std::to_string(first.points));
   if (commits.size() > 1) {

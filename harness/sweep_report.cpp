@@ -18,6 +18,7 @@
 #include "records.h"
 #include "report.h"
 #include "sweep.h"
+#include "sweep_search.h"
 
 namespace tippe {
 
@@ -996,6 +997,14 @@ std::vector<Block> build_doc(const std::vector<SweepRecord>& records, const std:
   if (points == 0) {
     doc.push_back({Block::Para, "No point has finished yet.", {}, {}});
     return doc;
+  }
+  // Boundary searches first: the number a user came for (the largest safe setting).
+  for (const ReportPart& part : boundary_report(records)) {
+    const Block::Kind kind = part.kind == ReportPart::H2 ? Block::H2
+                             : part.kind == ReportPart::H3 ? Block::H3
+                             : part.kind == ReportPart::Tab ? Block::Tab
+                                                            : Block::Para;
+    doc.push_back({kind, part.text, Table{part.header, part.rows}, {}});
   }
   Table st{{"setup", "engine", "fixed settings", "ladder"}, {}};
   bool any_grid = false;
