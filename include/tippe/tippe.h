@@ -46,7 +46,7 @@ struct RunSummary {
   double final_time = 0.0;  // s
   double final_tilt = 0.0;  // rad
   double energy_initial = 0.0, energy_final = 0.0;  // J
-  double jellett_initial = 0.0;  // kg m^2/s
+  double jellett_initial = 0.0;  // kg m^3/s (J = L_G . R_C)
   double jellett_max_relative_drift = 0.0;
   std::optional<double> jellett_drift_ball, jellett_drift_stem;
   double min_normal_force = 0.0;  // N
