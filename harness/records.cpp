@@ -183,6 +183,7 @@ json to_json(const RunRecord& r) {
   json settings = json::object();
   for (const auto& [k, v] : r.settings) settings[k] = v;
   return json{
+      {"format", kRunRecordFormat},
       {"scene", r.scene_name},
       {"scene_file", r.scene_file},
       {"scene_hash", r.scene_hash},
@@ -248,6 +249,11 @@ long long json_integer(const json& j, const char* key) {
 }
 
 RunRecord from_json(const json& j) {
+  // Summaries written before records carried a format have none; any other format is refused.
+  if (j.contains("format") && j.at("format") != kRunRecordFormat)
+    throw json::other_error::create(
+        501, "format: unknown record format " + j.at("format").dump().substr(0, 60) + " (expected " + kRunRecordFormat + ")",
+        &j);
   RunRecord r;
   r.scene_name = j.at("scene").get<std::string>();
   r.scene_file = j.at("scene_file").get<std::string>();

@@ -98,10 +98,14 @@ RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, Pr
 // make_simulator (unknown engine, bad setting) passes through.
 RunRecord run_scene(const Scene& scene, const std::string& engine, SampleSink* sink, ProgressFn progress = {});
 
+// The "format" of summary.json (schemas/run-summary.schema.json).
+constexpr const char* kRunRecordFormat = "tippe-run-1";
+
 // summary.json. Non-finite numbers are written as null. Settings become an object (key order
 // is not kept: from_json returns them sorted by key).
 nlohmann::json to_json(const RunRecord& r);
-// Throws nlohmann::json::exception for a missing or mistyped field.
+// Throws nlohmann::json::exception for a missing or mistyped field or another format; a
+// summary without "format" (written before it existed) is read as tippe-run-1.
 RunRecord from_json(const nlohmann::json& j);
 
 // An integer field of a record (counts of samples, steps, events): a JSON integer within the

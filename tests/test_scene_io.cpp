@@ -451,6 +451,16 @@ TEST(Records, JsonRoundTrip) {
   EXPECT_EQ(to_json(b), j);
 }
 
+// summary.json names its format; one written before it did is still read, another format is not.
+TEST(Records, FormatIsWrittenAndOldSummariesAreRead) {
+  nlohmann::json j = to_json(example_record());
+  EXPECT_EQ(j.at("format"), kRunRecordFormat);
+  j.erase("format");
+  EXPECT_EQ(to_json(from_json(j)).at("final_tilt"), j.at("final_tilt"));
+  j["format"] = "tippe-run-2";
+  EXPECT_THROW(from_json(j), nlohmann::json::exception);
+}
+
 bool has_temporaries(const fs::path& dir) {
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().filename().string().find(".tmp.") != std::string::npos) return true;

@@ -1,0 +1,66 @@
+# Install rules and the CMake package (find_package(tippe)): libraries, curated headers, config, tippe.pc.
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+# Installed headers, all under include/tippe/:
+#   tippe/tippe.h       the entry point of tippe::core (self-contained: no harness header is installed,
+#                       so harness files can move without changing the installed tree);
+#   tippe/analytic/*.h  the reference model (tippe::analytic), as in analytic/;
+#   tippe/engines/*.h   the simulator interface and adapter factories (tippe::engines). They include
+#                       "../analytic/..." relative to themselves, which the same layout keeps valid.
+set(TIPPE_INSTALLED_ENGINE_HEADERS simulator.h adapters.h)
+
+set(TIPPE_LIBRARY_TARGETS tippe_analytic tippe_engines tippe_core)
+set_target_properties(tippe_analytic PROPERTIES EXPORT_NAME analytic)
+set_target_properties(tippe_engines PROPERTIES EXPORT_NAME engines)
+set_target_properties(tippe_core PROPERTIES EXPORT_NAME core)
+# The subdirectories give their source directories as include paths; those hold for the build
+# tree only. Installed, every target's headers are found from include/ (<tippe/...>).
+foreach(t ${TIPPE_LIBRARY_TARGETS})
+  get_target_property(dirs ${t} INTERFACE_INCLUDE_DIRECTORIES)
+  set(wrapped "")
+  foreach(d ${dirs})
+    if(d MATCHES "^\\$<")
+      list(APPEND wrapped "${d}")
+    else()
+      list(APPEND wrapped "$<BUILD_INTERFACE:${d}>")
+    endif()
+  endforeach()
+  list(APPEND wrapped "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
+  set_target_properties(${t} PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${wrapped}")
+endforeach()
+
+install(TARGETS ${TIPPE_LIBRARY_TARGETS} EXPORT tippeTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+if(TARGET tippe)
+  install(TARGETS tippe RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()
+install(FILES ${PROJECT_SOURCE_DIR}/include/tippe/tippe.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tippe)
+file(GLOB TIPPE_ANALYTIC_HEADERS ${PROJECT_SOURCE_DIR}/analytic/*.h)
+install(FILES ${TIPPE_ANALYTIC_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tippe/analytic)
+list(TRANSFORM TIPPE_INSTALLED_ENGINE_HEADERS PREPEND ${PROJECT_SOURCE_DIR}/engines/)
+install(FILES ${TIPPE_INSTALLED_ENGINE_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tippe/engines)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/schemas/ DESTINATION ${CMAKE_INSTALL_DATADIR}/tippe/schemas)
+
+set(TIPPE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/tippe)
+install(EXPORT tippeTargets NAMESPACE tippe:: DESTINATION ${TIPPE_CMAKE_DIR})
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/tippeConfig.cmake.in
+                              ${PROJECT_BINARY_DIR}/tippeConfig.cmake INSTALL_DESTINATION ${TIPPE_CMAKE_DIR})
+# 0.x: a minor version may change the interface.
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/tippeConfigVersion.cmake COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/tippeConfig.cmake ${PROJECT_BINARY_DIR}/tippeConfigVersion.cmake
+        DESTINATION ${TIPPE_CMAKE_DIR})
+
+# pkg-config: the libraries are static, so their dependencies are listed for the link line too.
+if(TIPPE_ENGINES)
+  set(TIPPE_PC_REQUIRES "eigen3 tomlplusplus nlohmann_json bullet-float64 ode")
+  set(TIPPE_PC_LIBS "-lmujoco")
+else()
+  set(TIPPE_PC_REQUIRES "eigen3 tomlplusplus nlohmann_json")
+  set(TIPPE_PC_LIBS "")
+endif()
+# The prefix is found from the .pc file's own place, so `cmake --install --prefix DIR` works too.
+file(RELATIVE_PATH TIPPE_PC_TO_PREFIX /${CMAKE_INSTALL_LIBDIR}/pkgconfig /)
+configure_file(${PROJECT_SOURCE_DIR}/cmake/tippe.pc.in ${PROJECT_BINARY_DIR}/tippe.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/tippe.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
