@@ -530,6 +530,9 @@ class FakeSimulator : public Simulator {
     if (t_ >= 0.35) status_ = RunStatus::Diverged;
   }
   Observation observe() const override { return sample(t_, Surface::Ball, 1.0); }
+  BodyState state() const override { return observe().state; }
+  void set_state(const BodyState&) override {}
+  MassReadback mass_properties() const override { return {}; }
   WorkCounters work() const override { return work_; }
   RunStatus status() const override { return status_; }
   double status_time() const override { return status_ == RunStatus::Ok ? 0.0 : 0.35; }
