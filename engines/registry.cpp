@@ -10,10 +10,11 @@ const EngineInfo& analytic_engine_info();
 const EngineInfo& bullet_engine_info();
 const EngineInfo& ode_engine_info();
 const EngineInfo& mujoco_engine_info();
+const EngineInfo& dart_engine_info();
 
 const std::vector<EngineInfo>& engine_registry() {
   static const std::vector<EngineInfo> registry = {
-      analytic_engine_info(), bullet_engine_info(), ode_engine_info(), mujoco_engine_info(),
+      analytic_engine_info(), bullet_engine_info(), ode_engine_info(), mujoco_engine_info(), dart_engine_info(),
   };
   return registry;
 }

@@ -4,6 +4,7 @@ set -euo pipefail
 pkgs=(cmake g++ make pkg-config libeigen3-dev libbullet-dev libode-dev libmujoco-dev libqhull-dev
       libgtest-dev libgmock-dev libboost-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
       libbenchmark-dev gnuplot-nox
+      libdart-dev libdart-external-ikfast-dev  # DART 6.12 (engines/dart_sim.cpp); dart/dart.hpp needs ikfast's headers
       libopenmpi-dev openmpi-bin  # MPI sweeps: mpirun -np N tippe sweep (README, "Running a sweep on a cluster")
       clang libclang-rt-14-dev)  # clang 14 + its sanitizer and libFuzzer runtimes: scripts/sanitize.sh, scripts/fuzz.sh
 missing=()
