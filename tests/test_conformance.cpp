@@ -43,20 +43,25 @@ struct EngineRow {
   double set_get;         // |state() - x| after set_state(x) (lengths / R, velocities / scale)
   double resume;          // the same run continued 0.3 time units after set_state(state()), vs without
   double start_accel;     // |dv/dt| / g and |dw/dt| R / g over the first 1e-3 time units at rest upright
+  double contact_point;   // |engine's contact point - lowest point of the ball| / R, spinning tilted top (viscous), t in 0.1..0.3
+  double normal_force;    // |F_n - M g| / (M g) at rest upright after 0.5 time units
 };
 
 // Measured at the defaults (Release build, GCC 12; the recipe above). Adding an engine: one row
 // here (its instantiation) and nothing else in this file. Notes on the values: roll_t of every
 // engine is the 1e-3 sampling (t_roll = 0.952), the reference's is its located stick event;
 // MuJoCo's soft contact settles by 4.5e-7 R and starts with a 7.8e-2 g transient (the
-// penetration it rests at); the reference's resume is the cost of restarting its integrator.
+// penetration it rests at); the reference's resume is the cost of restarting its integrator;
+// Bullet's, ODE's and DART's contact point is that of their collision pass at the start of the
+// step, so it trails the body by one step's motion (9.4e-6 R here), MuJoCo's lies half its
+// penetration deep.
 const EngineRow kEngines[] = {
-    // name       rest     spin     precess  roll_t   roll_v   set_get  resume   accel
-    {"analytic", 0.0,     5.3e-16, 2.2e-15, 1.1e-14, 1.3e-14, 4.4e-16, 4.0e-14, 1.1e-16},
-    {"bullet",   0.0,     4.9e-14, 7.7e-06, 4.0e-04, 2.8e-13, 1.8e-16, 2.1e-14, 0.0},
-    {"ode",      5.0e-13, 7.5e-13, 1.3e-04, 4.0e-04, 2.0e-13, 1.8e-16, 8.5e-15, 1.3e-07},
-    {"mujoco",   4.5e-07, 0.0,     5.7e-16, 4.0e-04, 8.9e-08, 0.0,     0.0,     7.8e-02},
-    {"dart",     1.0e-11, 0.0,     7.7e-06, 4.0e-04, 5.6e-12, 5.6e-17, 5.1e-15, 9.1e-07},
+    // name       rest     spin     precess  roll_t   roll_v   set_get  resume   accel    point    F_n
+    {"analytic", 0.0,     5.3e-16, 2.2e-15, 1.1e-14, 1.3e-14, 4.4e-16, 4.0e-14, 1.1e-16, 0.0,     0.0},
+    {"bullet",   0.0,     4.9e-14, 7.7e-06, 4.0e-04, 2.8e-13, 1.8e-16, 2.1e-14, 0.0,     9.4e-06, 0.0},
+    {"ode",      5.0e-13, 7.5e-13, 1.3e-04, 4.0e-04, 2.0e-13, 1.8e-16, 8.5e-15, 1.3e-07, 9.4e-06, 0.0},
+    {"mujoco",   4.5e-07, 0.0,     5.7e-16, 4.0e-04, 8.9e-08, 0.0,     0.0,     7.8e-02, 2.2e-07, 0.0},
+    {"dart",     1.0e-11, 0.0,     7.7e-06, 4.0e-04, 5.6e-12, 5.6e-17, 5.1e-15, 9.1e-07, 9.4e-06, 0.0},
 };
 
 double scale() {
@@ -116,6 +121,8 @@ void expect_no_trouble(const Simulator& sim) {
   }
 }
 
+void PrintTo(const EngineRow& r, std::ostream* os) { *os << r.engine; }
+
 class Conformance : public ::testing::TestWithParam<EngineRow> {
  protected:
   const EngineRow& row() const { return GetParam(); }
@@ -162,6 +169,37 @@ TEST_P(Conformance, RestingUprightStartsWithoutAcceleration) {
   const double g = s.gravity, R = s.body.sphere_radius;
   const double accel = std::max(x.v_WG.norm() / h / g, x.w_B.norm() / h * R / g);
   check(row(), "start_accel", accel, row().start_accel);
+  expect_no_trouble(*sim);
+}
+
+TEST_P(Conformance, ContactPointAndNormalForce) {
+  // Where the engine puts the contact (its own report) against the exact geometry, and the
+  // weight it carries at rest: what the collision shapes and the contact solve make of the body.
+  Scene s = base_scene();
+  const double R = s.body.sphere_radius, W = s.mass.mass * s.gravity;
+  // The spinning tilted top under the viscous law (with Coulomb friction MuJoCo's contact hops
+  // while the ball slips and reports no force at most samples), sampled over 0.1..0.3.
+  s.contact.friction = FrictionLaw::Viscous;
+  s.contact.mu = 0.0;
+  s.contact.k = 1.0;
+  auto sim = make(s);
+  double worst = 0.0;
+  int valid = 0;
+  for (int k = 0; k <= 20; ++k) {
+    sim->advance_to(0.1 + 0.01 * k);
+    const Observation o = sim->observe();
+    if (!o.engine_contact_valid) continue;
+    ++valid;
+    worst = std::max(worst, (o.p_WC_engine - o.p_WC).norm() / R);
+  }
+  ASSERT_GE(valid, 10) << "contact reported at fewer than half of the samples of a top on its ball";
+  check(row(), "contact_point", worst, row().contact_point);
+  Scene rest = s;
+  rest.initial.tilt = 0.0;
+  rest.initial.spin = 0.0;
+  auto still = make(rest);
+  still->advance_to(0.5);
+  check(row(), "normal_force", std::abs(still->observe().normal_force - W) / W, row().normal_force);
   expect_no_trouble(*sim);
 }
 
