@@ -264,7 +264,10 @@ void DartSimulator::make_notes() {
   if (c.drilling > 0)
     notes_.push_back("drilling friction NOT modelled: DART 6.12's contact constraint has no torsional friction row, so this "
                      "run is of the scene without it (contact.drilling ignored)");
-  notes_.push_back("gyroscopic term w x I w evaluated explicitly at the start of each step (DART's forward dynamics)");
+  // World::step: forward dynamics at the step's start, velocities integrated, the contact LCP
+  // solved on them, then positions by the FreeJoint's exponential map.
+  notes_.push_back("semi-implicit Euler step (first order): forces, the gyroscopic term w x I w included, from the state at "
+                   "the start of each step (DART's forward dynamics)");
   if (!full_sphere_note().empty()) notes_.push_back(full_sphere_note());
 }
 
