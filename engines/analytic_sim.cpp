@@ -157,6 +157,12 @@ void adopt_reference_settings(Scene& scene) {
   s.rtol = scene.run.rtol;
   s.atol = scene.run.atol;
   s.self_check = scene.run.self_check;
+  // A key in both places would leave one silently unused (a sweep laddering run.rtol over a
+  // scene with [engines.analytic] rtol would run one tolerance only): refused.
+  for (const std::string& k : scene.run.alias_keys)
+    if (it->second.count(k))
+      throw std::invalid_argument("engines.analytic." + k + ": also given as run." + k +
+                                  " (its older spelling); give it once, in [engines.analytic]");
   SettingsReader r("analytic", it->second);
   s.visit(r);
   r.finish();

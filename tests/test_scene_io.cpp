@@ -137,6 +137,9 @@ std::vector<BadScene> bad_scenes() {
       {"mujoco_unknown_setting", b + "[engines.mujoco]\nno_such_key = 1\n", {}, {": engines.mujoco.no_such_key: "}, {}},
       {"analytic_unknown_setting", b + "[engines.analytic]\nstep = 1\n", {}, {": engines.analytic.step: unknown setting"}, {}},
       {"analytic_bad_method", b + "[engines.analytic]\nmethod = \"euler\"\n", {}, {": engines.analytic.method: "}, {}},
+      {"analytic_key_twice", b + "[engines.analytic]\nrtol = 1e-8\n", {}, {": engines.analytic.rtol: also given as run.rtol"}, {}},
+      {"analytic_key_twice_by_override", edit(edit(b, "rtol = 1e-10\n", ""), "atol = 1e-12\n", "") + "[engines.analytic]\nrtol = 1e-8\n",
+       {"run.rtol=1e-6"}, {": engines.analytic.rtol: also given as run.rtol"}, {}},
   };
 }
 
@@ -276,16 +279,17 @@ TEST(SceneIo, OverridesApply) {
 }
 
 TEST(SceneIo, ReferenceSettingsInEnginesAnalyticAndTheirOlderSpelling) {
-  // [engines.analytic] is where the reference's settings live; it wins over [run]'s older keys,
-  // which are still read and listed (the reference notes them as deprecated).
+  // [engines.analytic] is where the reference's settings live; [run]'s older keys are still read
+  // and listed (the reference notes them as deprecated); a key in both is refused (bad_scenes).
   TempDir dir{"tippe-test"};
   const std::string path =
-      dir.write("ref.toml", std::string(kBase) + "[engines.analytic]\nrtol = 1e-8\nmethod = \"dopri5\"\nself_check = false\n");
+      dir.write("ref.toml", edit(edit(kBase, "rtol = 1e-10\n", ""), "atol = 1e-12\n", "") +
+                                "[engines.analytic]\nrtol = 1e-8\nmethod = \"dopri5\"\nself_check = false\n");
   const Scene s = load_scene(path);
   EXPECT_EQ(s.run.rtol, 1e-8);
   EXPECT_EQ(s.run.method, "dopri5");
   EXPECT_FALSE(s.run.self_check);
-  EXPECT_EQ(make_simulator("analytic", s)->notes().size(), 1u);  // kBase's [run] still has rtol
+  EXPECT_TRUE(make_simulator("analytic", s)->notes().empty());
   const Scene old = load_scene(dir.write("old.toml", kBase));
   ASSERT_FALSE(old.run.alias_keys.empty());
   const auto notes = make_simulator("analytic", old)->notes();
