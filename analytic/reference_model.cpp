@@ -1012,8 +1012,21 @@ struct ReferenceModel::Impl {
 };
 
 ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene(scene)) {
+  start(scene, scene_initial_state(scene), scene.initial.height > 0);
+}
+
+ReferenceModel::ReferenceModel(const Scene& scene, const BodyState& x_start) : body_(BodyModel::from_scene(scene)) {
+  // In flight when the lowest surface is clear of the floor by more than round-off (and the
+  // scene allows flight); otherwise on the surface it rests on, as at a scene's own start.
+  double gap = surface_gap(body_, x_start, Surface::Ball);
+  if (body_.stem) gap = std::min(gap, surface_gap(body_, x_start, Surface::Stem));
+  start(scene, x_start, scene.contact.flight && gap > 1e-12 * body_.R);
+}
+
+void ReferenceModel::start(const Scene& scene, const BodyState& x0, bool in_flight) {
   impl_ = std::make_unique<Impl>(*this, scene);
-  const BodyState x0 = scene_initial_state(scene);
+  const double t0 = x0.t;
+  t_obs_ = t0;
   const double v_scale = std::max({x0.v_WG.norm(), x0.w_B.norm() * body_.R, std::sqrt(body_.g * body_.R)});
   impl_->v_scale = v_scale;
   impl_->slip_eps = std::max(1e-7, 10.0 * scene.run.rtol) * v_scale;
@@ -1045,10 +1058,10 @@ ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene
   const StateVector y0 = pack(x0);
   ContactMode none;
   impl_->y_obs = y0;
-  if (scene.initial.height > 0) {
+  if (in_flight) {
     // Starts in free flight; touchdowns are events like any other.
     impl_->mode = none;
-    impl_->restart(0.0, y0);
+    impl_->restart(t0, y0);
     impl_->ledger_obs = impl_->ledger;
     return;
   }
@@ -1056,10 +1069,10 @@ ReferenceModel::ReferenceModel(const Scene& scene) : body_(BodyModel::from_scene
   const bool on_stem = lower_surface(body_, x0.q_WB) == Surface::Stem;
   impl_->mode = impl_->settle(y0, {!on_stem, on_stem}, none);
   if (!impl_->mode.any_active()) {
-    impl_->end(ReferenceStatus::ContactLost, 0.0, "F_n < 0 at the start: the floor cannot hold the top", y0);
+    impl_->end(ReferenceStatus::ContactLost, t0, "F_n < 0 at the start: the floor cannot hold the top", y0);
     return;
   }
-  impl_->restart(0.0, impl_->project_booked(y0, 0.0));
+  impl_->restart(t0, impl_->project_booked(y0, t0));
   impl_->ledger_obs = impl_->ledger;
   impl_->y_obs = impl_->stepper.current_state();
 }

@@ -39,6 +39,9 @@ enum class ReferenceStatus { Ok, ContactLost, Failed };
 class ReferenceModel {
  public:
   explicit ReferenceModel(const Scene& scene);
+  // Starts from x_start at time x_start.t instead of the scene's initial state (the scene gives
+  // body, contact law and run settings): what Simulator::set_state restarts from.
+  ReferenceModel(const Scene& scene, const BodyState& x_start);
   ~ReferenceModel();
   ReferenceModel(const ReferenceModel&) = delete;
   ReferenceModel& operator=(const ReferenceModel&) = delete;
@@ -74,6 +77,7 @@ class ReferenceModel {
   const BodyModel& body() const { return body_; }
 
  private:
+  void start(const Scene& scene, const BodyState& x0, bool in_flight);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   BodyModel body_;

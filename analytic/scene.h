@@ -78,6 +78,9 @@ struct RunSpec {
   // The harness runs a second, independent reference over the same scene and says from which
   // time on the two part (the reference's self-check, harness/compare.h); false skips it.
   bool self_check = true;
+  // Which of rtol, atol, method, self_check the scene file gave in [run], their older spelling
+  // (they are the reference's settings, [engines.analytic]); the reference notes them.
+  std::vector<std::string> alias_keys{};
 };
 
 // One value of an engine setting as written in a scene or on the command line.

@@ -14,6 +14,7 @@
 #include "adapters.h"
 #include "bullet_settings.h"
 #include "fixed_step.h"
+#include "registry.h"
 #include "settings.h"
 
 #ifndef BT_USE_DOUBLE_PRECISION
@@ -150,10 +151,12 @@ class BulletSimulator : public FixedStepSimulator {
   std::vector<std::string> notes() const override;
 
   BulletReadback readback() const;
+  MassReadback mass_properties() const override;
 
  protected:
   void engine_step() override;
   BodyState engine_state() const override;
+  void engine_set_state(const BodyState& x) override;
   ContactReport engine_contacts() const override { return report_; }
   void apply_force_W(const Vec3& f_W, const Vec3& p_W) override;
   std::string engine_limit_hit() const override { return limit_; }
@@ -196,15 +199,7 @@ BulletSimulator::BulletSimulator(const Scene& scene)
   h_ = settings_.timestep / settings_.substeps;
 
   const ContactSpec& c = scene.contact;
-  switch (c.friction) {
-    case FrictionLaw::Coulomb: mu_ = c.mu; break;
-    case FrictionLaw::Rolling: mu_ = settings_.rolling_mu; break;
-    // Viscous and gliding: the base class applies F_t = -k v_C or -mu F_n v_C through
-    // apply_force_W; Bullet's own contact must then be frictionless.
-    case FrictionLaw::Viscous:
-    case FrictionLaw::Gliding:
-    case FrictionLaw::None: mu_ = 0; break;
-  }
+  mu_ = native_mu(settings_.rolling_mu);
   // Spinning friction is Bullet's torsional row: |tau| <= spinning * normal impulse per point,
   // i.e. a length, the scene's mu_d. Without drilling both stay exactly 0 (no torsional rows).
   spinning_ = c.drilling > 0 ? c.drilling : 0.0;
@@ -329,21 +324,15 @@ void BulletSimulator::configure_solver() {
 
 void BulletSimulator::make_notes() {
   const Scene& sc = scene();
-  const BodyModel& m = body();
   auto short_num = [](double v) {
     std::ostringstream os;
     os << v;
     return os.str();
   };
   const bool frictional = sc.contact.friction == FrictionLaw::Coulomb || sc.contact.friction == FrictionLaw::Rolling;
-  if (sc.contact.friction == FrictionLaw::Rolling)
-    notes_.push_back("rolling approximated by Coulomb friction with mu = " + short_num(settings_.rolling_mu) +
-                     " (written into each contact point: Bullet's own product of the two frictions is capped at 10)");
-  if (sc.contact.friction == FrictionLaw::Viscous)
-    notes_.push_back("viscous friction applied by the bench as an external force at the geometric contact point; Bullet contacts frictionless");
-  if (sc.contact.friction == FrictionLaw::Gliding)
-    notes_.push_back("gliding friction -mu F_n v_C applied by the bench as an external force at each geometric contact point, "
-                     "F_n per geom from Bullet's previous scene step (explicit); Bullet contacts frictionless");
+  notes_ = friction_law_notes({"Bullet", "", "Bullet's previous scene step (explicit)",
+                               " (written into each contact point: Bullet's own product of the two frictions is capped at 10)"},
+                              settings_.rolling_mu);
   if (frictional && settings_.friction_directions == 2)
     notes_.push_back("Coulomb friction as a box in two tangent directions (first along the slip velocity), each bounded by mu P_n: "
                      "the friction force can exceed mu F_n by up to sqrt(2)");
@@ -364,8 +353,7 @@ void BulletSimulator::make_notes() {
                      " penetration; shallower contacts corrected by Baumgarte velocity (adds kinetic energy)");
   if (settings_.gyroscopic == "none") notes_.push_back("gyroscopic term off (gyroscopic = none): not the top's physics");
   if (settings_.gyroscopic == "explicit") notes_.push_back("explicit gyroscopic torque: unstable for a fast spin");
-  if (m.stem && sc.body.truncation_height > 0 && sc.body.truncation_height / m.R < (m.R - m.r) / m.l)
-    notes_.push_back("ball modelled as a full sphere although its cut cap can reach the floor before the stem tip");
+  if (!full_sphere_note().empty()) notes_.push_back(full_sphere_note());
 }
 
 SettingsList BulletSimulator::settings() const {
@@ -528,6 +516,38 @@ BodyState BulletSimulator::engine_state() const {
   return x;
 }
 
+void BulletSimulator::engine_set_state(const BodyState& x) {
+  btRigidBody* b = o_.body.get();
+  btTransform T;
+  T.setIdentity();
+  T.setOrigin(to_bt(x.p_WG));
+  T.setRotation(to_bt(x.q_WB));
+  b->setCenterOfMassTransform(T);
+  b->setInterpolationWorldTransform(T);
+  b->setLinearVelocity(to_bt(x.v_WG));
+  b->setAngularVelocity(to_bt(x.q_WB * x.w_B));
+  b->setInterpolationLinearVelocity(to_bt(x.v_WG));
+  b->setInterpolationAngularVelocity(to_bt(x.q_WB * x.w_B));
+  b->updateInertiaTensor();
+  // Manifolds of the new state for the next step's report and the bench-applied laws.
+  o_.world->updateSingleAabb(b);
+  o_.world->performDiscreteCollisionDetection();
+  ContactSum sum;
+  collect_contacts(sum);
+  report_.ball = sum.ball;
+  report_.stem = sum.stem;
+}
+
+MassReadback BulletSimulator::mass_properties() const {
+  const btRigidBody* b = o_.body.get();
+  MassReadback mp;
+  mp.mass = 1.0 / b->getInvMass();
+  // The rigid body's frame is its centre of mass, built at G: the offset is zero by construction.
+  mp.p_GCm_B = Vec3::Zero();
+  mp.I_G_B = to_eigen(b->getLocalInertia()).asDiagonal();
+  return mp;
+}
+
 void BulletSimulator::apply_force_W(const Vec3& f_W, const Vec3& p_W) {
   pending_.push_back({f_W, p_W - to_eigen(o_.body->getCenterOfMassPosition())});
 }
@@ -606,5 +626,19 @@ std::unique_ptr<Simulator> make_bullet_simulator(const Scene& scene) {
 }
 
 void validate_bullet_settings(const Scene& scene) { (void)read_settings<BulletSettings>("bullet", scene); }
+
+const EngineInfo& bullet_engine_info() {
+  static const EngineInfo info = [] {
+    EngineInfo e;
+    e.name = "bullet";
+    e.role = EngineRole::Engine;
+    e.make = make_bullet_simulator;
+    set_settings_struct<BulletSettings>(e);
+    e.version = "bullet " + std::to_string(BT_BULLET_VERSION / 100) + "." + std::to_string(BT_BULLET_VERSION % 100);
+    e.colour = "#d62728";
+    return e;
+  }();
+  return info;
+}
 
 }  // namespace tippe

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "timing.h"
 
@@ -44,6 +45,63 @@ Observation FixedStepSimulator::observe() const {
   o.engine_contact_valid = c.point_valid;
   o.p_WC_engine = c.p_WC;
   return o;
+}
+
+void FixedStepSimulator::set_state(const BodyState& x) {
+  if (!(x.p_WG.allFinite() && x.v_WG.allFinite() && x.q_WB.coeffs().allFinite() && x.w_B.allFinite()) ||
+      x.q_WB.norm() < 1e-12)
+    throw std::invalid_argument(engine() + ": set_state: non-finite state or zero quaternion");
+  BodyState y = x;
+  y.t = time();
+  y.q_WB.normalize();
+  engine_set_state(y);
+  // The event probes restart from the new state: no crossing is found across the jump.
+  const BodyState z = engine_state();
+  last_.state = z;
+  last_.cos_theta = (z.q_WB * Vec3::UnitZ()).z();
+  last_.gap_ball = surface_gap(body_, z, Surface::Ball);
+  last_.gap_stem = body_.stem ? surface_gap(body_, z, Surface::Stem) : 1e300;
+}
+
+double FixedStepSimulator::native_mu(double rolling_mu) const {
+  switch (scene_.contact.friction) {
+    case FrictionLaw::Coulomb: return scene_.contact.mu;
+    case FrictionLaw::Rolling: return rolling_mu;
+    // Viscous and gliding: step_once applies F_t = -k v_C or -mu F_n v_C through apply_force_W.
+    case FrictionLaw::Viscous:
+    case FrictionLaw::Gliding:
+    case FrictionLaw::None: return 0.0;
+  }
+  return 0.0;
+}
+
+std::vector<std::string> FixedStepSimulator::friction_law_notes(const FrictionNoteText& text, double rolling_mu) const {
+  std::ostringstream mu;
+  mu << rolling_mu;
+  std::vector<std::string> notes;
+  switch (scene_.contact.friction) {
+    case FrictionLaw::Rolling:
+      notes.push_back("rolling approximated by Coulomb friction with mu = " + mu.str() + text.rolling_detail);
+      break;
+    case FrictionLaw::Viscous:
+      notes.push_back("viscous friction applied by the bench as an external force" + text.force_how +
+                      " at the geometric contact point; " + text.engine + " contacts frictionless");
+      break;
+    case FrictionLaw::Gliding:
+      notes.push_back("gliding friction -mu F_n v_C applied by the bench as an external force" + text.force_how +
+                      " at each geometric contact point, F_n per geom from " + text.normal_source + "; " + text.engine +
+                      " contacts frictionless");
+      break;
+    default: break;
+  }
+  return notes;
+}
+
+std::string FixedStepSimulator::full_sphere_note() const {
+  const BodyModel& m = body_;
+  if (m.stem && scene_.body.truncation_height > 0 && scene_.body.truncation_height / m.R < (m.R - m.r) / m.l)
+    return "ball modelled as a full sphere although its cut cap can reach the floor before the stem tip";
+  return {};
 }
 
 void FixedStepSimulator::fail(RunStatus s, double t, const std::string& why) {

@@ -37,6 +37,8 @@ class FixedStepSimulator : public Simulator {
   double status_time() const override { return status_time_; }
   std::string status_detail() const override { return status_detail_; }
   std::vector<Event> events() const override { return events_; }
+  BodyState state() const override { return engine_state(); }
+  void set_state(const BodyState& x) override;
 
   // Benchmarks only: n engine steps with none of the adapter's work (no events, checks,
   // observations or viscous/gliding forces), to measure the adapter's overhead against the bare engine.
@@ -59,6 +61,25 @@ class FixedStepSimulator : public Simulator {
   // Non-empty when the engine itself failed in the last step (e.g. an ODE internal error).
   virtual std::string engine_failure() const { return {}; }
   virtual long long engine_solver_iterations() const { return 0; }
+  // Writes p_WG, q_WB, v_WG, w_B into the engine at its current time (set_state checks them).
+  virtual void engine_set_state(const BodyState& x) = 0;
+
+  // The friction coefficient the engine's own contact carries for the scene's law: mu for
+  // Coulomb, the engine's stand-in rolling_mu for rolling, 0 for none and for the laws the
+  // bench applies itself (viscous, gliding: the engine's contact must then be frictionless).
+  double native_mu(double rolling_mu) const;
+  // How an engine words its part in the notes every engine shares about the friction law.
+  struct FrictionNoteText {
+    std::string engine;          // the library as written in notes: "ODE"
+    std::string force_how;       // how the bench's force goes in, e.g. " (mj_applyFT)"; may be empty
+    std::string normal_source;   // where F_n comes from: "ODE's previous step (joint feedback, explicit)"
+    std::string rolling_detail;  // appended to the rolling note, e.g. " (coefficient, approx1)"
+  };
+  // The notes on how the scene's friction law is realised (rolling stand-in, viscous or gliding
+  // law applied by the bench), the same for every engine; engine-specific notes come after.
+  std::vector<std::string> friction_law_notes(const FrictionNoteText& text, double rolling_mu) const;
+  // "ball modelled as a full sphere ..." when the cut cap can touch first; empty otherwise.
+  std::string full_sphere_note() const;
 
   const Scene& scene() const { return scene_; }
   const BodyModel& body() const { return body_; }

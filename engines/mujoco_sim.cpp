@@ -20,6 +20,7 @@
 #include "mujoco_settings.h"
 #include "mujoco_top.h"
 #include "mujoco_user_model.h"
+#include "registry.h"
 #include "settings.h"
 
 namespace tippe {
@@ -275,10 +276,14 @@ class MujocoSimulator : public FixedStepSimulator {
  protected:
   void engine_step() override;
   BodyState engine_state() const override;
+  void engine_set_state(const BodyState& x) override;
   ContactReport engine_contacts() const override { return report_; }
   void apply_force_W(const Vec3& f_W, const Vec3& p_W) override;
   std::string engine_limit_hit() const override { return limit_; }
   long long engine_solver_iterations() const override { return solver_iterations_; }
+
+ public:
+  MassReadback mass_properties() const override;
 
  private:
   ContactReport read_contacts() const { return read_contacts(d_); }
@@ -430,14 +435,9 @@ void MujocoSimulator::make_notes(const std::string& compiler_warning) {
     os << v;
     return os.str();
   };
-  if (c.friction == FrictionLaw::Rolling)
-    notes_.push_back("rolling approximated by Coulomb friction with mu = " + g(settings_.rolling_mu) + " and " +
-                     std::to_string(settings_.noslip_iterations_rolling) + " noslip iterations");
-  if (c.friction == FrictionLaw::Viscous)
-    notes_.push_back("viscous friction applied by the bench as an external force (mj_applyFT) at the geometric contact point; MuJoCo contacts frictionless");
-  if (c.friction == FrictionLaw::Gliding)
-    notes_.push_back("gliding friction -mu F_n v_C applied by the bench as an external force (mj_applyFT) at each geometric contact point, "
-                     "F_n per geom from MuJoCo's previous step (mj_contactForce, explicit); MuJoCo contacts frictionless");
+  notes_ = friction_law_notes({"MuJoCo", " (mj_applyFT)", "MuJoCo's previous step (mj_contactForce, explicit)",
+                               " and " + std::to_string(settings_.noslip_iterations_rolling) + " noslip iterations"},
+                              settings_.rolling_mu);
   if (c.friction == FrictionLaw::Coulomb && !(c.mu > 0) && settings_.condim == 0)
     notes_.push_back("Coulomb friction with mu = 0 simulated as frictionless contact (condim 1)");
   if (condim_ >= 3 && (c.friction == FrictionLaw::Coulomb || c.friction == FrictionLaw::Rolling) &&
@@ -491,8 +491,7 @@ void MujocoSimulator::make_notes(const std::string& compiler_warning) {
     notes_.push_back("while slipping, MuJoCo's convex contact pushes the ball off the floor: the contact hops (intermittent normal force, many switch events)");
   if (settings_.integrator != "RK4")
     notes_.push_back("integrator " + settings_.integrator + ": first order in the timestep");
-  if (m.stem && sc.body.truncation_height > 0 && sc.body.truncation_height / m.R < (m.R - m.r) / m.l)
-    notes_.push_back("ball modelled as a full sphere although its cut cap can reach the floor before the stem tip");
+  if (!full_sphere_note().empty()) notes_.push_back(full_sphere_note());
   if (!compiler_warning.empty()) notes_.push_back("mujoco compiler: " + compiler_warning);
 }
 
@@ -549,6 +548,42 @@ BodyState MujocoSimulator::engine_state() const {
   x.p_WG = Vec3(q[0], q[1], q[2]) + r_FG_W;
   x.v_WG = Vec3(v[0], v[1], v[2]) + (x.q_WB * x.w_B).cross(r_FG_W);
   return x;
+}
+
+void MujocoSimulator::engine_set_state(const BodyState& x) {
+  // The inverse of engine_state: F = G + z0 e_Z, v_F = v_G + w x (F - G); w in the body frame.
+  mjtNum* q = d_->qpos + qadr_;
+  mjtNum* v = d_->qvel + vadr_;
+  const Vec3 r_GF_W = x.q_WB * Vec3(0.0, 0.0, frame_z_);
+  const Vec3 p_F = x.p_WG + r_GF_W;
+  const Vec3 v_F = x.v_WG + (x.q_WB * x.w_B).cross(r_GF_W);
+  for (int i = 0; i < 3; ++i) {
+    q[i] = p_F[i];
+    v[i] = v_F[i];
+    v[3 + i] = x.w_B[i];
+  }
+  q[3] = x.q_WB.w();
+  q[4] = x.q_WB.x();
+  q[5] = x.q_WB.y();
+  q[6] = x.q_WB.z();
+  bad_state_.clear();
+  // Contacts and forces of the new state, as after construction.
+  mj_forward(m_, d_);
+  report_ = read_contacts();
+}
+
+MassReadback MujocoSimulator::mass_properties() const {
+  const MujocoModelReadback r = readback();
+  MassReadback mp;
+  mp.mass = r.mass;
+  // body_ipos is about the body frame's origin F = G + frame_origin_G.
+  mp.p_GCm_B = r.ipos_B + r.frame_origin_G;
+  const Eigen::Matrix3d R = r.iquat_B.normalized().toRotationMatrix();
+  // Principal moments about the centre of mass; shifted to G (parallel axis) when it is not at G.
+  const Eigen::Matrix3d I_cm = R * r.inertia.asDiagonal() * R.transpose();
+  const Vec3 c = mp.p_GCm_B;
+  mp.I_G_B = I_cm + r.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  return mp;
 }
 
 void MujocoSimulator::apply_force_W(const Vec3& f_W, const Vec3& p_W) {
@@ -627,6 +662,21 @@ std::unique_ptr<Simulator> make_mujoco_simulator(const Scene& scene) {
 void validate_mujoco_settings(const Scene& scene) {
   const MujocoSettings s = read_checked_settings(scene);
   if (!s.model.empty()) (void)check_user_model(scene, s, nullptr, nullptr, nullptr);
+}
+
+const EngineInfo& mujoco_engine_info() {
+  static const EngineInfo info = [] {
+    EngineInfo e;
+    e.name = "mujoco";
+    e.role = EngineRole::Engine;
+    e.make = make_mujoco_simulator;
+    e.validate = validate_mujoco_settings;
+    e.default_settings = [] { return list_settings(MujocoSettings{}); };
+    e.version = std::string("mujoco ") + mj_versionString();
+    e.colour = "#2ca02c";
+    return e;
+  }();
+  return info;
 }
 
 std::string mujoco_mjcf(const Scene& scene) {

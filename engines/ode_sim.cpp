@@ -16,6 +16,7 @@
 
 #include "adapters.h"
 #include "fixed_step.h"
+#include "registry.h"
 #include "settings.h"
 
 // LeakSanitizer (part of ASan): present in sanitizer builds (scripts/sanitize.sh) only.
@@ -210,10 +211,16 @@ class OdeSimulator : public FixedStepSimulator {
   std::vector<std::string> notes() const override { return notes_; }
 
   OdeMassReadback mass_readback() const;
+  MassReadback mass_properties() const override {
+    const OdeMassReadback r = mass_readback();
+    // dMass's c is the centre of mass relative to the body origin, which is built at G.
+    return {r.mass, r.c_B, r.I_B};
+  }
 
  protected:
   void engine_step() override;
   BodyState engine_state() const override;
+  void engine_set_state(const BodyState& x) override;
   ContactReport engine_contacts() const override { return report_; }
   void apply_force_W(const Vec3& f_W, const Vec3& p_W) override;
   std::string engine_limit_hit() const override { return limit_; }
@@ -340,15 +347,7 @@ dSurfaceParameters OdeSimulator::make_surface() const {
   const ContactSpec& c = scene().contact;
   dSurfaceParameters s{};
   const bool approx1 = settings_.friction_model == "approx1";
-  switch (c.friction) {
-    case FrictionLaw::Coulomb: s.mu = c.mu; break;
-    case FrictionLaw::Rolling: s.mu = settings_.rolling_mu; break;
-    // Viscous and gliding: the base class applies F_t = -k v_C or -mu F_n v_C through
-    // apply_force_W; the engine's own contact must then be frictionless.
-    case FrictionLaw::Viscous:
-    case FrictionLaw::Gliding:
-    case FrictionLaw::None: s.mu = 0; break;
-  }
+  s.mu = native_mu(settings_.rolling_mu);
   s.mode = dContactSoftERP | dContactSoftCFM;
   if (approx1) s.mode |= dContactApprox1_1 | dContactApprox1_2;
   s.soft_erp = settings_.soft_erp;
@@ -373,25 +372,14 @@ dSurfaceParameters OdeSimulator::make_surface() const {
 
 void OdeSimulator::make_notes() {
   const Scene& sc = scene();
-  const BodyModel& m = body();
   const bool approx1 = settings_.friction_model == "approx1";
-  auto num = [](double v) {
-    std::ostringstream os;
-    os << v;
-    return os.str();
-  };
+  notes_ = friction_law_notes({"ODE", "", "ODE's previous step (joint feedback, explicit)",
+                               approx1 ? " (coefficient, approx1)" : " (force bound, box)"},
+                              settings_.rolling_mu);
   if (sc.contact.drilling > 0 && sc.contact.drilling_law == DrillingLaw::Coupled)
     notes_.push_back("drilling decoupled: ODE bounds the spin torque (rhoN, |tau| <= mu_d F_n) and the friction force in rows of "
                      "their own; the scene's coupled law bounds them jointly (Leine-Glocker ellipse), which ODE cannot "
                      "represent: this run is the decoupled law");
-  if (sc.contact.friction == FrictionLaw::Rolling)
-    notes_.push_back("rolling approximated by Coulomb friction with mu = " + num(settings_.rolling_mu) +
-                     (approx1 ? " (coefficient, approx1)" : " (force bound, box)"));
-  if (sc.contact.friction == FrictionLaw::Viscous)
-    notes_.push_back("viscous friction applied by the bench as an external force at the geometric contact point; ODE contacts frictionless");
-  if (sc.contact.friction == FrictionLaw::Gliding)
-    notes_.push_back("gliding friction -mu F_n v_C applied by the bench as an external force at each geometric contact point, "
-                     "F_n per geom from ODE's previous step (joint feedback, explicit); ODE contacts frictionless");
   if (!approx1 && (sc.contact.friction == FrictionLaw::Coulomb || sc.contact.friction == FrictionLaw::Rolling))
     notes_.push_back("friction_model = box: mu is a constant force bound per friction direction, not a coefficient");
   if (approx1 && sc.contact.friction == FrictionLaw::Coulomb)
@@ -401,8 +389,7 @@ void OdeSimulator::make_notes() {
                      " iterations, random row order from ODE's process-wide seed");
   if (!settings_.finite_rotation) notes_.push_back("infinitesimal orientation update (finite_rotation = false)");
   if (!settings_.gyroscopic) notes_.push_back("gyroscopic term off (gyroscopic = false): not the top's physics");
-  if (m.stem && sc.body.truncation_height > 0 && sc.body.truncation_height / m.R < (m.R - m.r) / m.l)
-    notes_.push_back("ball modelled as a full sphere although its cut cap can reach the floor before the stem tip");
+  if (!full_sphere_note().empty()) notes_.push_back(full_sphere_note());
 }
 
 void OdeSimulator::near_callback(void* self, dGeomID a, dGeomID b) {
@@ -493,6 +480,16 @@ BodyState OdeSimulator::engine_state() const {
   return x;
 }
 
+void OdeSimulator::engine_set_state(const BodyState& x) {
+  if (failed_) return;  // ODE's internal error left the world unusable: the state stays NaN
+  dBodySetPosition(body_, x.p_WG.x(), x.p_WG.y(), x.p_WG.z());
+  const dQuaternion q_ode = {x.q_WB.w(), x.q_WB.x(), x.q_WB.y(), x.q_WB.z()};
+  dBodySetQuaternion(body_, q_ode);
+  dBodySetLinearVel(body_, x.v_WG.x(), x.v_WG.y(), x.v_WG.z());
+  const Vec3 w_W = x.q_WB * x.w_B;
+  dBodySetAngularVel(body_, w_W.x(), w_W.y(), w_W.z());
+}
+
 void OdeSimulator::apply_force_W(const Vec3& f_W, const Vec3& p_W) {
   // ODE zeroes the force accumulators after each step: this acts for the next step only.
   dBodyAddForceAtPos(body_, f_W.x(), f_W.y(), f_W.z(), p_W.x(), p_W.y(), p_W.z());
@@ -524,5 +521,19 @@ std::unique_ptr<Simulator> make_ode_simulator(const Scene& scene) {
 }
 
 void validate_ode_settings(const Scene& scene) { check_combination(read_settings<OdeSettings>("ode", scene), scene); }
+
+const EngineInfo& ode_engine_info() {
+  static const EngineInfo info = [] {
+    EngineInfo e;
+    e.name = "ode";
+    e.role = EngineRole::Engine;
+    e.make = make_ode_simulator;
+    set_settings_struct<OdeSettings>(e, [](const OdeSettings& s, const Scene& scene) { check_combination(s, scene); });
+    e.version = std::string("ode ") + dODE_VERSION;
+    e.colour = "#1f77b4";
+    return e;
+  }();
+  return info;
+}
 
 }  // namespace tippe

@@ -34,6 +34,15 @@ struct WorkCounters {
   double cpu_seconds = 0.0;       // CPU time of the calling thread in advance_to
 };
 
+// Mass properties as the engine holds them, read back from its own objects (never the scene's
+// numbers copied): mass, the centre of mass relative to G in the body frame B (zero when the
+// engine's body is built at G) and the inertia about G in B.
+struct MassReadback {
+  double mass = 0.0;
+  Vec3 p_GCm_B = Vec3::Zero();
+  Eigen::Matrix3d I_G_B = Eigen::Matrix3d::Zero();
+};
+
 // Ordered key=value pairs of every setting that decides accuracy, as used in the run.
 using SettingsList = std::vector<std::pair<std::string, std::string>>;
 
@@ -47,6 +56,12 @@ class Simulator {
   // when the status leaves Ok; never throws for a diverging engine.
   virtual void advance_to(double t) = 0;
   virtual Observation observe() const = 0;
+  // The body's state at the simulator's current time (t, p_WG, q_WB, v_WG, w_B of G).
+  virtual BodyState state() const = 0;
+  // Replaces position, attitude and velocities at the current time (x.t is ignored); events,
+  // work and status are kept. Throws std::invalid_argument for a non-finite state.
+  virtual void set_state(const BodyState& x) = 0;
+  virtual MassReadback mass_properties() const = 0;
   virtual WorkCounters work() const = 0;
   virtual RunStatus status() const = 0;
   virtual double status_time() const = 0;
@@ -57,9 +72,10 @@ class Simulator {
   virtual std::vector<std::string> notes() const { return {}; }
 };
 
-// Builds a simulator by engine name ("analytic", "bullet", "ode", "mujoco"); throws
-// std::invalid_argument for an unknown engine or an invalid setting.
+// Builds a simulator by its registered name (engines/registry.h); throws std::invalid_argument
+// for an unknown engine or an invalid setting.
 std::unique_ptr<Simulator> make_simulator(const std::string& engine, const Scene& scene);
+// Every registered name, the reference first.
 std::vector<std::string> available_engines();
 
 }  // namespace tippe

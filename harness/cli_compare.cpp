@@ -6,6 +6,7 @@
 #include <memory>
 #include <thread>
 
+#include "registry.h"
 #include "cli.h"
 #include "compare.h"
 #include "report.h"
@@ -19,7 +20,7 @@ namespace fs = std::filesystem;
 
 struct CompareCliOptions {
   std::string scene;
-  std::vector<std::string> engines = {"bullet", "ode", "mujoco"};
+  std::vector<std::string> engines = engine_names();
   std::string out;
   int jobs = 0;  // 0: one per core, at most one per run
   std::vector<std::string> sets;
@@ -100,7 +101,7 @@ Command setup_compare(CLI::App& app) {
       "compare", "Run the analytic reference and engines on one scene; write comparison.json, trajectories and a report");
   add_scene_options(sub, o->scene, o->sets);
   // One comma-separated value per --engines, so that the scene may follow it.
-  sub->add_option("--engines", o->engines, "Engines to compare, comma-separated")
+  sub->add_option("--engines", o->engines, "Engines to compare, comma-separated (" + engine_list_text(available_engines()) + ")")
       ->delimiter(',')
       ->allow_extra_args(false)
       ->check(CLI::IsMember(available_engines()))

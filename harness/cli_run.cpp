@@ -7,6 +7,7 @@
 
 #include "cli.h"
 #include "progress.h"
+#include "registry.h"
 #include "records.h"
 #include "scene_io.h"
 
@@ -18,7 +19,7 @@ namespace fs = std::filesystem;
 
 struct RunOptions {
   std::string scene;
-  std::string engine = "analytic";
+  std::string engine = reference_engine().name;
   std::string out;
   std::vector<std::string> sets;
 };
@@ -138,7 +139,7 @@ Command setup_run(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
   CLI::App* sub = app.add_subcommand("run", "Run a scene on one engine; write summary.json and trajectory.csv");
   add_scene_options(sub, o->scene, o->sets);
-  sub->add_option("--engine", o->engine, "analytic, bullet, ode or mujoco")
+  sub->add_option("--engine", o->engine, engine_list_text(available_engines()))
       ->check(CLI::IsMember(available_engines()))
       ->capture_default_str();
   sub->add_option("--out", o->out, "Output directory (default out/<scene name>-<engine>)");

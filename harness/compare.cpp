@@ -474,7 +474,7 @@ SelfCheck run_self_check(const Scene& scene, const RunRecord& reference, const T
   second.run.rtol = plan.rtol;
   second.run.atol = plan.atol;
   TrajectorySink sink;
-  const RunRecord check = run_scene(second, "analytic", &sink);
+  const RunRecord check = run_scene(second, reference_engine().name, &sink);
   return compare_reference_runs(reference, ref_traj, check, sink.trajectory, scene);
 }
 
@@ -528,7 +528,7 @@ json summary_with_bounded_events(const RunRecord& r) {
 
 json to_json(const Comparison& c) {
   json versions = json::object();
-  versions[c.reference.engine.empty() ? "analytic" : c.reference.engine] = c.reference.engine_version;
+  versions[c.reference.engine.empty() ? reference_engine().name : c.reference.engine] = c.reference.engine_version;
   json engines = json::array();
   for (const EngineResult& e : c.engines) {
     versions[e.run.engine] = e.run.engine_version;
@@ -817,7 +817,7 @@ void copy_file_atomic(const fs::path& from, const fs::path& to) {
   fs::rename(tmp, to);
 }
 
-std::string analytic_version(const Scene& scene) { return make_simulator("analytic", scene)->version(); }
+std::string analytic_version(const Scene& scene) { return make_simulator(reference_engine().name, scene)->version(); }
 
 // DIR/self_check.json: the self-check of the reference cached beside it. Keyed by the physics
 // hash, the reference's provenance (commit, host, date: a summary rewritten by a later run no
@@ -880,7 +880,7 @@ std::string reference_from_text(const std::string& summary_json, const std::stri
                                 RunRecord& record, Trajectory& trajectory) {
   try {
     const RunRecord r = from_json(json::parse(summary_json));
-    if (r.engine != "analytic") return where + ": not a reference run (engine " + r.engine + ")";
+    if (r.engine != reference_engine().name) return where + ": not a reference run (engine " + r.engine + ")";
     if (physics_hash(r.scene_spec) != hash) return where + ": made from other physics";
     if (r.provenance.git_commit != build_info().git_commit)
       return where + ": made by the build of commit " + r.provenance.git_commit + ", this is " +
@@ -930,7 +930,7 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
   std::vector<Task> tasks(options.engines.size() + 1);
   tasks.reserve(tasks.size() + 1);  // room for the self-check: `ref` stays valid
   Task& ref = tasks[0];
-  ref.engine = "analytic";
+  ref.engine = reference_engine().name;
   if (!out.empty()) ref.csv_path = (out / "reference.csv").string();
   fs::path cache_dir;
   if (!options.cache_dir.empty()) {
@@ -970,7 +970,7 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
     if (!c.self_check) {
       check_slot = tasks.size();
       tasks.emplace_back();
-      tasks.back().engine = "analytic";
+      tasks.back().engine = reference_engine().name;
       tasks.back().scene = &check_scene;
     }
   }

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "registry.h"
 #include "records.h"
 #include "scene.h"
 
@@ -143,7 +144,7 @@ nlohmann::json to_json(const SelfCheck& s);
 SelfCheck self_check_from_json(const nlohmann::json& j);
 
 struct CompareOptions {
-  std::vector<std::string> engines = {"bullet", "ode", "mujoco"};
+  std::vector<std::string> engines = engine_names();  // every registered engine (engines/registry.h)
   int jobs = 1;
   std::string out_dir;    // where comparison.json, trajectories and reports go ("" = none)
   std::string cache_dir;  // reference cache ("" = no cache)

@@ -56,7 +56,7 @@ struct Check {
   std::string name;
   std::string scene;       // as written in the gate file
   std::string scene_path;  // resolved against the gate file's directory
-  std::string engine;      // bullet | ode | mujoco
+  std::string engine;      // a registered engine (engines/registry.h), not the reference
   std::vector<std::string> set;        // [defaults].set then the check's own, as written
   std::optional<double> duration;      // the check's duration, else [defaults].duration
   std::vector<std::string> overrides;  // what load_scene gets: run.duration=... first, then `set`
@@ -80,7 +80,7 @@ struct GateFile {
 // "FILE: cannot read: reason". Rules:
 //  - top level: [defaults] (optional) and [[check]] (at least one); nothing else.
 //  - a check: name (required, unique; letters, digits, '.', '_', '-'), scene (path relative to
-//    the gate file), engine (bullet | ode | mujoco), set (array of "KEY=VALUE" strings), duration
+//    the gate file), engine (a registered engine), set (array of "KEY=VALUE" strings), duration
 //    (number > 0, overrides run.duration), status (a run status: ok, contact_lost, diverged,
 //    unphysical, clamped, failed; default ok), require_same_events (boolean, default false),
 //    max (table: gate metric -> finite number >= 0), allow_unconverged (boolean, default false).

@@ -1,6 +1,8 @@
 // Comparison reports from records alone: Markdown for terminals and CI logs, a self-contained HTML page, gnuplot SVG plots.
 #include "report.h"
 
+#include "registry.h"
+
 
 #include <algorithm>
 #include <cmath>
@@ -292,11 +294,11 @@ std::pair<std::string, std::string> self_check_lines(const json& c) {
 
 // Fixed per engine so that a colour means the same engine on every page.
 std::string engine_colour(const std::string& engine, size_t index) {
-  static const std::map<std::string, std::string> fixed = {
-      {"bullet", "#d62728"}, {"ode", "#1f77b4"}, {"mujoco", "#2ca02c"}, {"analytic", "#9467bd"}};
-  static const char* const spare[] = {"#ff7f0e", "#8c564b", "#e377c2", "#17becf"};
-  auto it = fixed.find(engine);
-  return it != fixed.end() ? it->second : spare[index % 4];
+  // Registered engines have their own (engines/registry.h); a name from an old record that is
+  // no longer registered gets a spare one.
+  if (const EngineInfo* e = find_engine(engine)) return e->colour;
+  static const char* const spare[] = {"#8c564b", "#e377c2", "#17becf", "#bcbd22"};
+  return spare[index % 4];
 }
 
 // Indices that keep the shape of a series in at most ~2 * buckets points: the first and last

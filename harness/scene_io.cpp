@@ -1,5 +1,7 @@
 // Scene files: TOML -> Scene with every key checked, command-line overrides, and Scene -> JSON.
 #include "scene_io.h"
+
+#include "registry.h"
 #include "toml_text.h"
 
 #include <algorithm>
@@ -489,6 +491,8 @@ class Interpreter {
         fail("run.method", "must be \"bulirsch_stoer\", \"dopri5\" or \"rosenbrock4\", got \"" + r.method + "\"");
     }
     r.self_check = opt_bool(t, "run", "self_check").value_or(true);
+    for (const char* k : {"rtol", "atol", "method", "self_check"})
+      if (t.contains(k)) r.alias_keys.push_back(k);
   }
 
   SettingValue to_setting(const toml::node& n, const std::string& path) const {
@@ -518,6 +522,7 @@ class Interpreter {
     resolve_mujoco_model(s);
     try {
       validate_engine_settings(s);
+      if (reference_engine().adopt) reference_engine().adopt(s);
     } catch (const std::invalid_argument& e) {
       throw SceneError(file_ + ": " + e.what());
     }

@@ -35,6 +35,7 @@
 #include "output_dir.h"
 #include "provenance.h"
 #include "records.h"
+#include "registry.h"
 #include "scene_io.h"
 #include "sweep_search.h"
 #include "toml_text.h"
@@ -330,11 +331,13 @@ class SweepReader {
   // A sweep compares settings of one engine on fixed physics; a setup that could change the
   // scene itself would make its errors mean nothing.
   void check_setting_key(const std::string& engine, const std::string& k, const std::string& where) const {
-    if (engine == "analytic") {
-      if (k != "run.rtol" && k != "run.atol" && k != "run.method")
-        fail(where, "\"" + k +
-                        "\" is not a setting of the analytic model (run.rtol, run.atol, run.method); a sweep "
-                        "never changes the physics");
+    if (engine == reference_engine().name) {
+      // The reference's settings: [engines.NAME] or their older spelling in [run].
+      const std::string e = "engines." + engine + ".";
+      if (k != "run.rtol" && k != "run.atol" && k != "run.method" && k != e + "rtol" && k != e + "atol" &&
+          k != e + "method")
+        fail(where, "\"" + k + "\" is not a setting of the " + engine + " model (" + e + "rtol, " + e + "atol, " + e +
+                        "method, or run.rtol, run.atol, run.method); a sweep never changes the physics");
     } else if (k.rfind("engines." + engine + ".", 0) != 0 || k.size() == engine.size() + 9) {
       fail(where, "\"" + k + "\" is not a setting of " + engine + " (expected engines." + engine +
                       ".KEY); a sweep never changes the physics");
@@ -1062,7 +1065,7 @@ std::string compute_reference_texts(const Scene& scene) {
   TrajectorySink sink({&csv});
   RunRecord record;
   try {
-    auto sim = make_simulator("analytic", scene);
+    auto sim = make_simulator(reference_engine().name, scene);
     record = run_simulator(*sim, scene, &sink);
   } catch (const std::exception& e) {
     return failed_reference_text(sink.trajectory.size() ? sink.trajectory.t.back() : 0.0,
@@ -1209,7 +1212,7 @@ double point_weight(const SweepPlan& plan, const SweepPoint& p) {
   // The time step may be either axis of a grid.
   double v = is_step(s.ladder_key) ? p.ladder_value : std::nan("");
   if (s.has_grid() && is_step(s.grid_key)) v = s.grid_values[p.grid_index];
-  const double per_time = v > 0 ? 1.0 / v : (s.engine == "analytic" ? 100.0 : 1e4);
+  const double per_time = v > 0 ? 1.0 / v : (s.engine == reference_engine().name ? 100.0 : 1e4);
   return plan.spec.repeats * p.scene.run.duration * per_time;
 }
 

@@ -14,6 +14,7 @@
 #include <tuple>
 #include <vector>
 
+#include "registry.h"
 #include "gnuplot.h"
 #include "records.h"
 #include "report.h"
@@ -435,10 +436,8 @@ const std::vector<MetricInfo>& metric_infos() {
 }
 
 std::string engine_colour(const std::string& engine) {
-  static const std::map<std::string, std::string> fixed = {
-      {"bullet", "#d62728"}, {"ode", "#1f77b4"}, {"mujoco", "#2ca02c"}, {"analytic", "#9467bd"}};
-  auto it = fixed.find(engine);
-  return it != fixed.end() ? it->second : "#ff7f0e";
+  // Registered engines have their own (engines/registry.h).
+  return engine_plot_colour(engine);
 }
 
 // One series of a chart: a setup's points as (x, y), in ladder order.
@@ -564,7 +563,7 @@ std::vector<std::string> render_charts(const fs::path& dir, const std::vector<Ch
         gp << gp_literal(dat) << " index " << i
            << " using 1:2 with points pt 2 ps 1.5 lc rgb '#000000' title columnheader(1)";
       } else {
-        const bool analytic = s.engine == "analytic";
+        const bool analytic = s.engine == reference_engine().name;
         gp << gp_literal(dat) << " index " << i << " using 1:2 with linespoints lw " << (analytic ? 2.5 : 1.5)
            << " dt " << (1 + s.variant % 5) << " pt " << (analytic ? 5 : 7 + 2 * (s.variant % 4)) << " ps 0.9 lc rgb "
            << gp_literal(engine_colour(s.engine)) << " title columnheader(1)";
@@ -613,7 +612,7 @@ void scene_section(const SceneGroup& s, const std::vector<std::string>& images, 
   std::vector<std::string> engines;
   for (const SetupGroup& u : s.setups) {
     all.insert(all.end(), u.points.begin(), u.points.end());
-    if (u.engine == "analytic") analytic.insert(analytic.end(), u.points.begin(), u.points.end());
+    if (u.engine == reference_engine().name) analytic.insert(analytic.end(), u.points.begin(), u.points.end());
     if (std::find(engines.begin(), engines.end(), u.engine) == engines.end()) engines.push_back(u.engine);
   }
 

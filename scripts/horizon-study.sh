@@ -19,12 +19,12 @@ cell() {
   [ "$stem" = none ] && stem="-"
   printf '%s / %s (%s sw)' "$inv" "$stem" "$switches"
 }
-echo "| scene | horizon | reference | ODE | Bullet | MuJoCo, frame at G | MuJoCo, frame at O |"
-echo "|---|---|---|---|---|---|---|"
+echo "| scene | horizon | reference | ODE | Bullet | MuJoCo, frame at G | MuJoCo, frame at O | DART |"
+echo "|---|---|---|---|---|---|---|---|"
 for scene in toy leine_glocker leine_glocker_drilling leine_glocker_twin mujoco_tutorial; do
   for horizon in scene 30; do
     row="| \`$scene\` | $horizon |"
-    for run in analytic ode bullet mujoco-com mujoco-ball_centre; do
+    for run in analytic ode bullet mujoco-com mujoco-ball_centre dart; do
       args=(run "harness/scenes/$scene.toml" --engine "${run%%-*}" --out "$work/$scene-$horizon-$run")
       [ "$horizon" = 30 ] && args+=(--set run.duration=30)
       case "$run" in mujoco-*) args+=(--set "engines.mujoco.body_frame=\"${run#mujoco-}\"") ;; esac

@@ -12,6 +12,7 @@
 #include "../analytic/initial_state.h"
 #include "../analytic/reference_model.h"
 #include "adapters.h"
+#include "registry.h"
 #include "scene_io.h"
 #include "simulator.h"
 
@@ -258,7 +259,8 @@ TEST_P(GlidingEngineSlide, MatchesTheClosedForm) {
   std::printf("sliding ball, %s: v_G against the closed form, worst %.3g of v0\n", GetParam().c_str(), worst);
   EXPECT_LT(worst, 1e-3);
 }
-INSTANTIATE_TEST_SUITE_P(Engines, GlidingEngineSlide, ::testing::Values("bullet", "ode", "mujoco"),
+// Every registered engine (engines/registry.h).
+INSTANTIATE_TEST_SUITE_P(Engines, GlidingEngineSlide, ::testing::ValuesIn(engine_names()),
                          [](const auto& info) { return info.param; });
 
 // MuJoCo's own model cannot carry the law (the bench applies it): export-mjcf names it.

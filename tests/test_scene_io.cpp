@@ -135,6 +135,11 @@ std::vector<BadScene> bad_scenes() {
       {"engine_bad_type", b + "[engines.ode]\ntimestep = \"small\"\n", {}, {": engines.ode.timestep: "}, {}},
       {"engine_unsupported_value", b + "[engines.ode]\ntimestep = { a = 1 }\n", {}, {": engines.ode.timestep: unsupported value"}, {}},
       {"mujoco_unknown_setting", b + "[engines.mujoco]\nno_such_key = 1\n", {}, {": engines.mujoco.no_such_key: "}, {}},
+      {"analytic_unknown_setting", b + "[engines.analytic]\nstep = 1\n", {}, {": engines.analytic.step: unknown setting"}, {}},
+      {"analytic_bad_method", b + "[engines.analytic]\nmethod = \"euler\"\n", {}, {": engines.analytic.method: "}, {}},
+      {"analytic_key_twice", b + "[engines.analytic]\nrtol = 1e-8\n", {}, {": engines.analytic.rtol: also given as run.rtol"}, {}},
+      {"analytic_key_twice_by_override", edit(edit(b, "rtol = 1e-10\n", ""), "atol = 1e-12\n", "") + "[engines.analytic]\nrtol = 1e-8\n",
+       {"run.rtol=1e-6"}, {": engines.analytic.rtol: also given as run.rtol"}, {}},
   };
 }
 
@@ -271,6 +276,28 @@ TEST(SceneIo, OverridesApply) {
   EXPECT_EQ(std::get<double>(s.engines.at("ode").at("timestep")), 1e-4);
   const Scene q = load_scene(path, {"engines.ode.stepper=\"step\""});
   EXPECT_EQ(std::get<std::string>(q.engines.at("ode").at("stepper")), "step");
+}
+
+TEST(SceneIo, ReferenceSettingsInEnginesAnalyticAndTheirOlderSpelling) {
+  // [engines.analytic] is where the reference's settings live; [run]'s older keys are still read
+  // and listed (the reference notes them as deprecated); a key in both is refused (bad_scenes).
+  TempDir dir{"tippe-test"};
+  const std::string path =
+      dir.write("ref.toml", edit(edit(kBase, "rtol = 1e-10\n", ""), "atol = 1e-12\n", "") +
+                                "[engines.analytic]\nrtol = 1e-8\nmethod = \"dopri5\"\nself_check = false\n");
+  const Scene s = load_scene(path);
+  EXPECT_EQ(s.run.rtol, 1e-8);
+  EXPECT_EQ(s.run.method, "dopri5");
+  EXPECT_FALSE(s.run.self_check);
+  EXPECT_TRUE(make_simulator("analytic", s)->notes().empty());
+  const Scene old = load_scene(dir.write("old.toml", kBase));
+  ASSERT_FALSE(old.run.alias_keys.empty());
+  const auto notes = make_simulator("analytic", old)->notes();
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("run.rtol"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("deprecated"), std::string::npos) << notes[0];
+  const Scene fresh = load_scene(dir.write("new.toml", edit(edit(kBase, "rtol = 1e-10\n", ""), "atol = 1e-12\n", "")));
+  EXPECT_TRUE(fresh.run.alias_keys.empty());
 }
 
 TEST(SceneIo, HashIsStableAndSeesOverridesAndBytes) {
@@ -540,6 +567,9 @@ class FakeSimulator : public Simulator {
     if (t_ >= 0.35) status_ = RunStatus::Diverged;
   }
   Observation observe() const override { return sample(t_, Surface::Ball, 1.0); }
+  BodyState state() const override { return observe().state; }
+  void set_state(const BodyState&) override {}
+  MassReadback mass_properties() const override { return {}; }
   WorkCounters work() const override { return work_; }
   RunStatus status() const override { return status_; }
   double status_time() const override { return status_ == RunStatus::Ok ? 0.0 : 0.35; }

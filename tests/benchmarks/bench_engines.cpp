@@ -2,17 +2,17 @@
 #include <benchmark/benchmark.h>
 
 #include "../../engines/fixed_step.h"
+#include "registry.h"
 #include "scene_io.h"
 
 namespace tippe {
-namespace {
 
 Scene toy() { return load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/toy.toml"); }
 
 constexpr long long kSteps = 2000;  // 0.2 s of the toy at the engines' default 1e-4 step
 
 // Through the adapter: advance_to with the shared loop's events, failure checks and forces.
-void BM_AdapterSteps(benchmark::State& state, const char* engine) {
+void BM_AdapterSteps(benchmark::State& state, const std::string& engine) {
   const Scene scene = toy();
   for (auto _ : state) {
     state.PauseTiming();
@@ -26,7 +26,7 @@ void BM_AdapterSteps(benchmark::State& state, const char* engine) {
 }
 
 // The same engine world stepped bare: the engine's own cost.
-void BM_BareSteps(benchmark::State& state, const char* engine) {
+void BM_BareSteps(benchmark::State& state, const std::string& engine) {
   const Scene scene = toy();
   for (auto _ : state) {
     state.PauseTiming();
@@ -39,14 +39,18 @@ void BM_BareSteps(benchmark::State& state, const char* engine) {
   state.SetItemsProcessed(state.iterations() * kSteps);
 }
 
-BENCHMARK_CAPTURE(BM_AdapterSteps, bullet, "bullet")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BareSteps, bullet, "bullet")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_AdapterSteps, ode, "ode")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BareSteps, ode, "ode")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_AdapterSteps, mujoco, "mujoco")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BareSteps, mujoco, "mujoco")->Unit(benchmark::kMillisecond);
-
-}  // namespace
 }  // namespace tippe
 
-BENCHMARK_MAIN();
+// Both benchmarks for every registered engine (engines/registry.h): a new engine is measured
+// without an edit here.
+int main(int argc, char** argv) {
+  for (const std::string& e : tippe::engine_names()) {
+    benchmark::RegisterBenchmark(("BM_AdapterSteps/" + e).c_str(), tippe::BM_AdapterSteps, e)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_BareSteps/" + e).c_str(), tippe::BM_BareSteps, e)->Unit(benchmark::kMillisecond);
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,58 @@
+// The engine registry: one EngineInfo per simulator (name, role, factory, settings, version, colour).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "settings.h"
+#include "simulator.h"
+
+namespace tippe {
+
+// The reference is what every engine is measured against; there is exactly one.
+enum class EngineRole { Reference, Engine };
+
+struct EngineInfo {
+  std::string name;      // as in --engine, [engines.NAME] and records
+  EngineRole role = EngineRole::Engine;
+  std::function<std::unique_ptr<Simulator>(const Scene&)> make;
+  // Reads the scene's [engines.NAME] table into the engine's settings struct (its `visit`) and
+  // checks combinations; throws std::invalid_argument naming the key.
+  std::function<void(const Scene&)> validate;
+  // The settings struct's defaults as key=value (what `tippe info` lists).
+  std::function<SettingsList()> default_settings;
+  // The reference only: writes its [engines.NAME] table into scene.run (the values the
+  // reference and the harness read), so that [run]'s older keys and the table agree.
+  std::function<void(Scene&)> adopt;
+  std::string version;   // library version, as Simulator::version() reports it
+  std::string colour;    // plot colour (#rrggbb) in every report
+};
+
+// Builds the `validate` and `default_settings` members from a settings struct with `visit`.
+template <class Settings>
+void set_settings_struct(EngineInfo& info, std::function<void(const Settings&, const Scene&)> check = nullptr) {
+  const std::string name = info.name;
+  info.validate = [name, check](const Scene& scene) {
+    const Settings s = read_settings<Settings>(name, scene);
+    if (check) check(s, scene);
+  };
+  info.default_settings = [] { return list_settings(Settings{}); };
+}
+
+// Every registered simulator, the reference first, then the engines in registration order.
+const std::vector<EngineInfo>& engine_registry();
+// nullptr for an unknown name.
+const EngineInfo* find_engine(const std::string& name);
+// Throws std::invalid_argument naming the known engines for an unknown name.
+const EngineInfo& engine_info(const std::string& name);
+const EngineInfo& reference_engine();
+// The names with role Engine (the default engine list of compare and gates).
+std::vector<std::string> engine_names();
+// "a, b, c or d": the names for messages and CLI help.
+std::string engine_list_text(const std::vector<std::string>& names);
+// A colour for any name (registered: its own; otherwise grey), for reports of old records.
+std::string engine_plot_colour(const std::string& name);
+
+}  // namespace tippe
