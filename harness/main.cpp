@@ -7,6 +7,9 @@
 
 #include "cli.h"
 #include "progress.h"
+#include "provenance.h"
+#include "registry.h"
+#include "tippe/tippe.h"
 #include "scene_io.h"
 
 int main(int argc, char** argv) {
@@ -18,6 +21,13 @@ int main(int argc, char** argv) {
   bool quiet = false;
   app.add_flag("-q,--quiet", quiet, "No progress on stderr (errors and warnings still go there)");
   app.fallthrough();
+  // Version, commit and the engine libraries this build links (from the engine registry).
+  app.set_version_flag("--version", [] {
+    const BuildInfo b = build_info();
+    std::string text = "tippe " + tippe::version() + " (commit " + b.git_commit + ", " + b.compiler + ")";
+    for (const EngineInfo& e : engine_registry()) text += "\n  " + e.name + ": " + e.version;
+    return text;
+  });
   // Adding a subcommand: write cli_NAME.cpp with setup_NAME, declare it in cli.h, list it here.
   const cli::Setup commands[] = {cli::setup_run, cli::setup_export_mjcf, cli::setup_import_mjcf, cli::setup_info,
                                   cli::setup_compare, cli::setup_report, cli::setup_sweep,
@@ -50,6 +60,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::cerr << "tippe: error: " << e.what() << "\n(run with --help for usage)\n";

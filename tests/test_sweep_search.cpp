@@ -518,7 +518,8 @@ TEST(SweepSearchShipped, BoundariesCoverEveryEngineAndEveryShippedScene) {
       EXPECT_EQ(u.search->criterion, "inversion_time_rel_error <= 0.01");
       // Where the reference inverts (reports/<scene>/report.md): the others would be n/a.
       EXPECT_EQ(u.only_scenes, (std::vector<std::string>{"source_dimensionless", "toy_viscous", "rutstam_ball",
-                                                          "rutstam_gliding_ball"}));
+                                                          "rutstam_gliding_ball", "leine_glocker_coupled",
+                                                          "leine_glocker_twin_coupled"}));
       inversion.insert(u.engine);
     }
   }
@@ -527,8 +528,9 @@ TEST(SweepSearchShipped, BoundariesCoverEveryEngineAndEveryShippedScene) {
     EXPECT_TRUE(regime.count(e)) << e << " has no regime search";
     EXPECT_TRUE(inversion.count(e)) << e << " has no inversion-time search";
   }
-  // Planned up front: the coarse grids (5 values over 4 decades) of 10 x 3 regime searches and 4 x 3 others.
-  EXPECT_EQ(plan.planned, 5u * (10 * 3 + 4 * 3));
+  // Planned up front: the coarse grids (5 values over 4 decades) of 12 scenes x 4 engines' regime
+  // searches and 6 x 4 others.
+  EXPECT_EQ(plan.planned, 5u * (12 * 4 + 6 * 4));
 }
 
 TEST(SweepSearchInput, SetupScenesNameScenesOfTheSweep) {
