@@ -55,7 +55,8 @@ install(FILES ${PROJECT_BINARY_DIR}/tippeConfig.cmake ${PROJECT_BINARY_DIR}/tipp
 # pkg-config: the libraries are static, so their dependencies are listed for the link line too.
 if(TIPPE_ENGINES)
   set(TIPPE_PC_REQUIRES "eigen3 tomlplusplus nlohmann_json bullet-float64 ode")
-  set(TIPPE_PC_LIBS "-lmujoco")
+  # DART links as its imported target `dart` (libdart and its FCL); the .pc names them directly.
+  set(TIPPE_PC_LIBS "-lmujoco -ldart -lfcl")
 else()
   set(TIPPE_PC_REQUIRES "eigen3 tomlplusplus nlohmann_json")
   set(TIPPE_PC_LIBS "")

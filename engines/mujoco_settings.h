@@ -65,6 +65,10 @@ struct MujocoSettings {
   // ball); MuJoCo's capsule-plane routine may still add a second contact at that end within the
   // margin, and the two shapes' contact frames differ, hence a choice to sweep.
   std::string stem_shape = "capsule";
+  // The geoms' contact margin (scene length): MuJoCo makes a contact, and its soft constraint
+  // acts, from this distance on, before the surfaces touch. 0 (MuJoCo's default) is the rigid
+  // contact the reference has; a user's model may carry one, hence a choice to sweep.
+  double margin = 0.0;
   // The user's own MJCF (`tippe import-mjcf`): run as written, with its own options; the keys
   // above that are given in the scene override its opt fields (timestep, integrator, cone,
   // impratio, solver, iterations, tolerance, noslip_iterations, noslip_tolerance) and its
@@ -91,6 +95,7 @@ struct MujocoSettings {
     v("rolling_mu", rolling_mu, 0.0, 1e15);
     v("body_frame", body_frame, {"com", "ball_centre"});
     v("stem_shape", stem_shape, {"capsule", "tip_sphere"});
+    v("margin", margin, 0.0, 1.0);
     v("model", model);
     v("body", body);
     v("keyframe", keyframe);

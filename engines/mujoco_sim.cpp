@@ -60,7 +60,7 @@ MujocoSettings read_checked_settings(const Scene& scene) {
   check_combination(s);
   if (!s.model.empty()) {
     // These shape the bench's own MJCF only; the user's model decides them.
-    for (const char* k : {"body_frame", "stem_shape", "condim", "rolling_mu", "noslip_iterations_rolling"})
+    for (const char* k : {"body_frame", "stem_shape", "margin", "condim", "rolling_mu", "noslip_iterations_rolling"})
       if (mujoco_setting_given(scene, k))
         setting_error(k, "not used with engines.mujoco.model (the model decides it: edit the model instead)");
   } else {
@@ -169,7 +169,7 @@ std::string build_mjcf(const Scene& scene, const MujocoSettings& s) {
   os << "    <geom condim=\"" << condim << "\" friction=\"" << vec({friction.x(), friction.y(), friction.z()})
      << "\" solref=\"" << vec({s.solref[0], s.solref[1]}) << "\" solimp=\""
      << vec({s.solimp[0], s.solimp[1], s.solimp[2], s.solimp[3], s.solimp[4]})
-     << "\" margin=\"0\" gap=\"0\"/>\n";
+     << "\" margin=\"" << num(s.margin) << "\" gap=\"0\"/>\n";
   os << "  </default>\n";
   os << "  <worldbody>\n";
   // contype/conaffinity: floor (1, 2) against body geoms (2, 1) collide; body geoms never

@@ -353,10 +353,11 @@ long long softest_agreeing(const std::vector<SweepRecord>& records);
 // Where the reference does not invert and a time-step ladder's runs leave its regime (they
 // invert): how that departure behaves as the step shrinks, read from the finished runs (status
 // ok) finest last. "goes away": the finest runs are in the regime (from `in_regime_from` down);
-// "moves later": every finished run inverts and the inversion time grows as the step falls (each
-// finer run inverts no earlier than 1 % before the next coarser one); "stays": every finished run
-// inverts and the time does not grow; "none": no finished run leaves the regime; "mixed": the
-// regime comes and goes along the ladder; "-": not a time-step ladder, the reference inverts, or
+// "converges": every finished run inverts and the two finest within 1 % of each other (the
+// engine's model, not its step); "moves later": every finished run inverts, each finer one no
+// earlier than 1 % before the next coarser, the two finest apart; "earlier at a finer step":
+// neither; "none": no finished run leaves the regime; "mixed": the regime comes and goes along
+// the ladder; "-": not a time-step ladder, the reference inverts, or
 // fewer than two finished runs. The answer holds up to the runs' horizon only.
 struct RegimeTrend {
   std::string verdict;

@@ -81,6 +81,25 @@ TEST(StemShapeApplied, MujocoWritesASphereGeom) {
   EXPECT_NE(mujoco_mjcf(sphere).find("name=\"stem\" type=\"sphere\""), std::string::npos);
 }
 
+// MuJoCo's contact margin reaches its model: the floor's and the body's geoms carry it (MuJoCo
+// adds the two geoms' margins), and 0 writes the rigid contact.
+TEST(MujocoMargin, ReachesTheModel) {
+  EXPECT_NE(mujoco_mjcf(load_scene(kScenes + "toy.toml")).find("margin=\"0\" gap=\"0\""), std::string::npos);
+  const Scene m = load_scene(kScenes + "toy.toml", {"engines.mujoco.margin=0.001"});
+  EXPECT_NE(mujoco_mjcf(m).find("margin=\"0.001\" gap=\"0\""), std::string::npos);
+  // A margin makes the contact act before touching: the resting top sits higher (the soft
+  // constraint's equilibrium moves out by about the margin).
+  auto rest_height = [](const Scene& s) {
+    auto sim = make_simulator("mujoco", s);
+    sim->advance_to(0.2);
+    return sim->state().p_WG.z();
+  };
+  Scene rest = load_scene(kScenes + "toy.toml", {"initial.spin=0", "initial.tilt=0", "run.duration=0.2"});
+  Scene rest_m = load_scene(kScenes + "toy.toml",
+                            {"initial.spin=0", "initial.tilt=0", "run.duration=0.2", "engines.mujoco.margin=0.001"});
+  EXPECT_GT(rest_height(rest_m) - rest_height(rest), 5e-4);
+}
+
 // Bullet keeps a manifold point, and its warm-start impulses, while the next step's point lies
 // within the breaking threshold. With Coulomb friction the friction rows start from those
 // impulses, so the threshold moves the result (measured on toy over 3 s: the final tilt 0.0744
