@@ -1,22 +1,16 @@
 // The MuJoCo adapter's user-model mode (engines.mujoco.model): the model checked against the scene, the scene's overrides on it, its notes and settings.
 #include "mujoco_user_model.h"
 
+#include "settings.h"
+
 #include <algorithm>
-#include <locale>
 #include <sstream>
 #include <stdexcept>
 
 namespace tippe {
 namespace {
 
-std::string num(double v) {
-  if (v == 0.0) v = 0.0;
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
-  os.precision(17);
-  os << v;
-  return os.str();
-}
+std::string num(double v) { return round_trip_text(v); }
 
 struct ModelOwner {
   mjModel* m = nullptr;

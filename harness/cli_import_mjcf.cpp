@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "mujoco_import.h"
 #include "output_dir.h"
+#include "settings.h"
 #include "scene_io.h"
 
 namespace tippe::cli {
@@ -27,15 +28,10 @@ struct ImportOptions {
   double sample_interval = 0.0;  // 0: the larger of 1 ms and the model's timestep
 };
 
-// A TOML float that reads back to the same double (17 significant digits, always with a point
-// or an exponent).
+// A TOML float that reads back to the same double (round_trip_text, always with a point or an
+// exponent).
 std::string tf(double v) {
-  if (v == 0.0) v = 0.0;
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
-  os.precision(17);
-  os << v;
-  std::string s = os.str();
+  std::string s = round_trip_text(v);
   if (s.find_first_of(".e") == std::string::npos) s += ".0";
   return s;
 }
