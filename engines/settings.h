@@ -19,14 +19,19 @@ namespace tippe {
 // The shortest text that reads back as exactly v ("0.2", not "0.20000000000000001"): what a
 // record or a model file needs to reproduce a number, without the digits it does not have.
 // printf's %g at the fewest significant digits that read back exactly: "0.0001" rather than the
-// shortest "1e-04", as people write it.
+// shortest "1e-04", as people write it; whole numbers below 1e17 in full ("1000", not "1e+03").
 inline std::string round_trip_text(double v) {
   if (v == 0.0) v = 0.0;  // "-0" reads as 0 anyway; keep the text plain
   char buf[64];
-  for (int digits = 1; digits <= 17; ++digits) {
+  int digits = 1;
+  for (; digits <= 17; ++digits) {
     std::snprintf(buf, sizeof buf, "%.*g", digits, v);
     if (std::strtod(buf, nullptr) == v) break;
   }
+  // %g goes to an exponent once the number has more integer digits than significant ones; as
+  // many significant digits as integer ones print it plainly, and more digits still read back.
+  const int integer_digits = std::isfinite(v) && std::abs(v) >= 1 ? static_cast<int>(std::log10(std::abs(v))) + 1 : 0;
+  if (integer_digits > digits && integer_digits <= 17) std::snprintf(buf, sizeof buf, "%.*g", integer_digits, v);
   return buf;
 }
 

@@ -109,7 +109,12 @@ TEST(Cli, NumbersCarryTheDigitsTheyHave) {
   EXPECT_EQ(round_trip_text(0.2), "0.2");
   EXPECT_EQ(round_trip_text(0.85), "0.85");
   EXPECT_EQ(round_trip_text(-0.0), "0");
-  for (double v : {0.1, 1.0 / 3.0, 2.0e-300, 1e-4, 123456.789, 9.81})
+  EXPECT_EQ(round_trip_text(1e-4), "0.0001");
+  EXPECT_EQ(round_trip_text(1000.0), "1000");
+  EXPECT_EQ(round_trip_text(200.0), "200");
+  EXPECT_EQ(round_trip_text(-1500.0), "-1500");
+  EXPECT_EQ(round_trip_text(1e20), "1e+20");
+  for (double v : {0.1, 1.0 / 3.0, 2.0e-300, 1e-4, 123456.789, 9.81, 1000.0, 99999999999999990.0, 1e20})
     EXPECT_EQ(std::stod(round_trip_text(v)), v) << round_trip_text(v);
 }
 
