@@ -13,9 +13,9 @@
 #include <sstream>
 #include <utility>
 
-#include "compare.h"
+#include "measure/compare.h"
 #include "gnuplot.h"
-#include "records.h"
+#include "records/records.h"
 
 namespace tippe {
 

@@ -16,10 +16,10 @@
 
 #include "registry.h"
 #include "gnuplot.h"
-#include "records.h"
+#include "records/records.h"
 #include "report.h"
-#include "sweep.h"
-#include "sweep_search.h"
+#include "sweep/sweep.h"
+#include "sweep/sweep_search.h"
 
 namespace tippe {
 

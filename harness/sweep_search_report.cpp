@@ -6,7 +6,7 @@
 #include <set>
 #include <tuple>
 
-#include "sweep_search.h"
+#include "sweep/sweep_search.h"
 
 namespace tippe {
 

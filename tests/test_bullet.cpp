@@ -12,7 +12,7 @@
 #include "bullet_sim.h"
 #include "initial_state.h"
 #include "observables.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 #include "simulator.h"
 
 namespace tippe {

@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "classify.h"
-#include "compare.h"
-#include "records.h"
-#include "scene_io.h"
+#include "measure/classify.h"
+#include "measure/compare.h"
+#include "records/records.h"
+#include "io/scene_io.h"
 
 namespace tippe {
 namespace {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "cli.h"
+#include "cli/cli.h"
 #include "settings.h"
 #include "test_files.h"
 #include "test_process.h"

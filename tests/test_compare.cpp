@@ -13,11 +13,11 @@
 #include <set>
 #include <sstream>
 
-#include "compare.h"
+#include "measure/compare.h"
 #include "gnuplot.h"
-#include "records.h"
+#include "records/records.h"
 #include "report.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;

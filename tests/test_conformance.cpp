@@ -12,7 +12,7 @@
 
 #include "../analytic/contact_dynamics.h"
 #include "../analytic/initial_state.h"
-#include "records.h"
+#include "records/records.h"
 #include "registry.h"
 
 namespace tippe {

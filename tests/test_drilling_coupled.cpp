@@ -8,7 +8,7 @@
 #include <string>
 
 #include "../analytic/reference_model.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 #include "simulator.h"
 
 namespace tippe {

@@ -13,8 +13,8 @@
 #include "initial_state.h"
 #include "observables.h"
 #include "reference_model.h"
-#include "scene_io.h"
-#include "sweep.h"
+#include "io/scene_io.h"
+#include "sweep/sweep.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;

@@ -14,11 +14,11 @@
 #include <set>
 #include <sstream>
 
-#include "compare.h"
-#include "gate.h"
+#include "measure/compare.h"
+#include "gating/gate.h"
 #include "registry.h"
-#include "records.h"
-#include "scene_io.h"
+#include "records/records.h"
+#include "io/scene_io.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;

@@ -13,7 +13,7 @@
 #include "../analytic/reference_model.h"
 #include "adapters.h"
 #include "registry.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 #include "simulator.h"
 
 namespace tippe {

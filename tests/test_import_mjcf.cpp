@@ -22,8 +22,8 @@
 #include "initial_state.h"
 #include "mujoco_import.h"
 #include "mujoco_sim.h"
-#include "records.h"
-#include "scene_io.h"
+#include "records/records.h"
+#include "io/scene_io.h"
 #include "simulator.h"
 #include "test_process.h"
 

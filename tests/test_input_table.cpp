@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "compare.h"
-#include "gate.h"
-#include "records.h"
-#include "scene_io.h"
-#include "sweep.h"
+#include "measure/compare.h"
+#include "gating/gate.h"
+#include "records/records.h"
+#include "io/scene_io.h"
+#include "sweep/sweep.h"
 #include "test_files.h"
 #include "test_process.h"
 

@@ -7,7 +7,7 @@
 
 #include "adapters.h"
 #include "bullet_sim.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 
 namespace tippe {
 namespace {

@@ -23,7 +23,7 @@
 
 #include "adapters.h"
 #include "mujoco_sim.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 #include "simulator.h"
 
 namespace tippe {

@@ -11,8 +11,8 @@
 #include <thread>
 #include <vector>
 
-#include "output_dir.h"
-#include "records.h"
+#include "io/output_dir.h"
+#include "records/records.h"
 #include "test_files.h"
 #include "test_process.h"
 

@@ -12,7 +12,7 @@
 
 #include "../analytic/initial_state.h"
 #include "../analytic/reference_model.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 
 namespace tippe {
 namespace {

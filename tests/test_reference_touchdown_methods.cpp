@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "../analytic/reference_model.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 
 namespace tippe {
 namespace {

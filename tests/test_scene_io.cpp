@@ -11,8 +11,8 @@
 #include <limits>
 #include <sstream>
 
-#include "records.h"
-#include "scene_io.h"
+#include "records/records.h"
+#include "io/scene_io.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;

@@ -6,10 +6,10 @@
 #include <filesystem>
 #include <string>
 
-#include "compare.h"
-#include "records.h"
+#include "measure/compare.h"
+#include "records/records.h"
 #include "report.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;

@@ -7,7 +7,7 @@
 #include <filesystem>
 
 #include "../analytic/reference_model.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 
 namespace tippe {
 namespace {

@@ -13,8 +13,8 @@
 #include <sstream>
 #include <thread>
 
-#include "scene_io.h"
-#include "sweep.h"
+#include "io/scene_io.h"
+#include "sweep/sweep.h"
 #include "test_files.h"
 #include "test_process.h"
 #include "test_records.h"

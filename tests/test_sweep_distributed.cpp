@@ -12,9 +12,9 @@
 #include <set>
 #include <thread>
 
-#include "mpi_farm.h"
-#include "sweep.h"
-#include "task_farm.h"
+#include "sweep/mpi_farm.h"
+#include "sweep/sweep.h"
+#include "measure/task_farm.h"
 #include "test_files.h"
 #include "test_process.h"
 #include "test_records.h"

@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "gate.h"
-#include "gate_boundary.h"
+#include "gating/gate.h"
+#include "gating/gate_boundary.h"
 #include "simulator.h"
-#include "scene_io.h"
-#include "sweep.h"
-#include "sweep_search.h"
+#include "io/scene_io.h"
+#include "sweep/sweep.h"
+#include "sweep/sweep_search.h"
 #include "test_files.h"
 #include "test_process.h"
 #include "test_records.h"

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "sweep.h"
-#include "sweep_search.h"
+#include "sweep/sweep.h"
+#include "sweep/sweep_search.h"
 #include "test_files.h"
 #include "test_process.h"
 #include "test_records.h"

@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <string>
 
-#include "records.h"
+#include "records/records.h"
 #include "registry.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 
 namespace tippe {
 namespace {

@@ -3,7 +3,7 @@
 
 #include "../../engines/fixed_step.h"
 #include "registry.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 
 namespace tippe {
 

@@ -6,7 +6,7 @@
 #include "../../analytic/contact_dynamics.h"
 #include "../../analytic/initial_state.h"
 #include "../../analytic/reference_model.h"
-#include "scene_io.h"
+#include "io/scene_io.h"
 
 namespace tippe {
 namespace {

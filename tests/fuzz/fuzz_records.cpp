@@ -9,8 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "compare.h"
-#include "records.h"
+#include "measure/compare.h"
+#include "records/records.h"
 
 namespace {
 

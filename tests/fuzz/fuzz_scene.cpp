@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "scene_io.h"
+#include "io/scene_io.h"
 
 namespace {
 

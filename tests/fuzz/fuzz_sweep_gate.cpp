@@ -10,9 +10,9 @@
 #include <fstream>
 #include <string>
 
-#include "gate.h"
-#include "scene_io.h"
-#include "sweep.h"
+#include "gating/gate.h"
+#include "io/scene_io.h"
+#include "sweep/sweep.h"
 
 namespace fs = std::filesystem;
 

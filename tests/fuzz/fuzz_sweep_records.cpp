@@ -6,7 +6,7 @@
 #include <exception>
 #include <string>
 
-#include "sweep.h"
+#include "sweep/sweep.h"
 
 namespace {
 

@@ -1,0 +1,131 @@
+// `tippe compare` (reference and engines on one scene, with a report) and `tippe report` (the report regenerated from records).
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <thread>
+
+#include "registry.h"
+#include "cli/cli.h"
+#include "measure/compare.h"
+#include "report.h"
+#include "io/scene_io.h"
+
+namespace tippe::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CompareCliOptions {
+  std::string scene;
+  std::vector<std::string> engines = engine_names();
+  std::string out;
+  int jobs = 0;  // 0: one per core, at most one per run
+  std::vector<std::string> sets;
+  std::string cache = "out/.reference-cache";
+  bool no_cache = false;
+  bool no_plots = false;
+  bool no_self_check = false;
+};
+
+void print_table_and_findings(const nlohmann::json& j) {
+  // The scene's own notes (an imported model's approximations) head the report.
+  if (j.contains("scene") && j.at("scene").is_object())
+    for (const auto& n : j.at("scene").value("notes", nlohmann::json::array()))
+      if (n.is_string()) std::printf("scene note: %s\n", n.get<std::string>().c_str());
+  std::printf("%s", render_summary_table(j).c_str());
+  for (const auto& f : report_findings(j)) std::printf("- %s\n", f.c_str());
+}
+
+int compare(const CompareCliOptions& o) {
+  Scene scene = load_scene(o.scene, o.sets);
+  if (o.no_self_check) scene.run.self_check = false;
+  CompareOptions opts;
+  opts.engines = o.engines;
+  const int runs = static_cast<int>(o.engines.size()) + 1;
+  opts.jobs = o.jobs > 0 ? o.jobs : std::max(1, std::min(runs, static_cast<int>(std::thread::hardware_concurrency())));
+  const fs::path dir = o.out.empty() ? fs::path("out") / (scene.name + "-compare") : fs::path(o.out);
+  opts.cache_dir = o.no_cache ? "" : o.cache;
+  opts.plots = !o.no_plots;
+  // run_comparison checks its input before it writes anything; so does this, before DIR exists.
+  try {
+    check_compare_input(scene, opts);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  // The comparison's files are one unit, written beside DIR and swapped in whole.
+  const InterruptGuard interrupts;
+  OutputDir out(dir);
+  opts.out_dir = out.stage(false).string();
+  const Comparison c = run_comparison(scene, opts);
+  out.commit();
+  print_table_and_findings(to_json(c));
+  std::printf("report: %s\n", (dir / "index.html").string().c_str());
+  return 0;
+}
+
+int report(const std::string& dir, bool no_plots, bool summary_line) {
+  const fs::path file = fs::path(dir) / "comparison.json";
+  std::ifstream in(file);
+  if (!in) throw UsageError(file.string() + ": cannot read (not a comparison directory?)");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+    comparison_from_json(j);  // checks that every field the report reads is there
+  } catch (const nlohmann::json::exception& e) {
+    throw UsageError(file.string() + ": not a comparison record: " + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(file.string() + ": " + e.what());
+  }
+  if (summary_line) {
+    std::printf("%s\n", render_summary_line(j).c_str());
+    return 0;
+  }
+  // The rebuilt report replaces the old one as a unit; the records stay as they are.
+  const InterruptGuard interrupts;
+  OutputDir out(dir);
+  write_report(out.stage(true).string(), j, !no_plots);
+  out.commit();
+  print_table_and_findings(j);
+  std::printf("report: %s\n", (fs::path(dir) / "index.html").string().c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command setup_compare(CLI::App& app) {
+  auto o = std::make_shared<CompareCliOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "compare", "Run the analytic reference and engines on one scene; write comparison.json, trajectories and a report");
+  add_scene_options(sub, o->scene, o->sets);
+  // One comma-separated value per --engines, so that the scene may follow it.
+  sub->add_option("--engines", o->engines, "Engines to compare, comma-separated (" + engine_list_text(available_engines()) + ")")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(CLI::IsMember(available_engines()))
+      ->capture_default_str();
+  sub->add_option("--out", o->out, "Output directory (default out/<scene name>-compare)");
+  sub->add_option("--jobs,-j", o->jobs, "Runs in parallel (default: one per core)")->check(CLI::PositiveNumber);
+  sub->add_option("--cache", o->cache, "Reference cache directory")->capture_default_str();
+  sub->add_flag("--no-cache", o->no_cache, "Always run the reference; leave the cache alone");
+  sub->add_flag("--no-plots", o->no_plots, "Skip the gnuplot SVGs");
+  sub->add_flag("--no-self-check", o->no_self_check,
+                "Skip the reference's self-check (a second reference run with another method; same as "
+                "--set run.self_check=false)");
+  return {sub, [o] { return compare(*o); }};
+}
+
+Command setup_report(CLI::App& app) {
+  auto dir = std::make_shared<std::string>();
+  auto no_plots = std::make_shared<bool>(false), summary_line = std::make_shared<bool>(false);
+  CLI::App* sub = app.add_subcommand(
+      "report", "Regenerate report.md, index.html and plots of a `tippe compare` directory from its records");
+  sub->add_option("dir", *dir, "Directory written by tippe compare")->required();
+  sub->add_flag("--no-plots", *no_plots, "Skip the gnuplot SVGs");
+  sub->add_flag("--summary-line", *summary_line, "Only print who inverts, on one line (writes nothing)");
+  return {sub, [dir, no_plots, summary_line] { return report(*dir, *no_plots, *summary_line); }};
+}
+
+}  // namespace tippe::cli

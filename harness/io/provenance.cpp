@@ -1,0 +1,8 @@
+// Build provenance compiled into the harness (compiler, flags, commit).
+#include "io/provenance.h"
+
+namespace tippe {
+
+BuildInfo build_info() { return {TIPPE_GIT_COMMIT, TIPPE_COMPILER, TIPPE_CXX_FLAGS}; }
+
+}  // namespace tippe

@@ -1,0 +1,695 @@
+// Scene files: TOML -> Scene with every key checked, command-line overrides, and Scene -> JSON.
+#include "io/scene_io.h"
+
+#include "registry.h"
+#include "io/toml_text.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "adapters.h"
+#include "mass_properties.h"
+#include "records/records.h"
+
+namespace tippe {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// A byte budget, not a count, against a typo in sample_interval: a run's trajectory.csv is at
+// most kMaxTrajectoryBytes at the longest row (kTrajectoryRowMax), and the same bound caps what a
+// run keeps in memory (a sweep's reference holds its CSV text, ~450 bytes a row, and every
+// comparison a Trajectory, 92 bytes a row, per run). 1 GiB allows ~1.2e6 samples, 30 times the
+// longest shipped scene (extremes/long_horizon: 41900); the count it replaces, 1e8, let ~55 GB through.
+constexpr double kMaxTrajectoryBytes = 1024.0 * 1024.0 * 1024.0;
+constexpr double kMaxSamples = kMaxTrajectoryBytes / static_cast<double>(kTrajectoryRowMax);
+// Below a few machine epsilons (2.2e-16) the integrator's error estimate is rounding noise: no
+// step can meet the tolerance and the run only ends by failing.
+constexpr double kMinRtol = 1e-15;
+// Looser than 1 % the reference is no longer a reference.
+constexpr double kMaxRtol = 1e-2;
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(12);
+  os << v;
+  return os.str();
+}
+
+std::string join_path(const std::string& prefix, const std::string& key) {
+  return prefix.empty() ? key : prefix + "." + key;
+}
+
+std::string fnv1a64_hex(const std::string& bytes, const std::vector<std::string>& overrides) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  auto feed = [&h](unsigned char c) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  };
+  for (unsigned char c : bytes) feed(c);
+  // A separator keeps {"a", "bc"} and {"ab", "c"} apart.
+  for (const auto& o : overrides) {
+    feed(0);
+    for (unsigned char c : o) feed(c);
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+bool is_bare_key(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+  });
+}
+
+// Length of the well-formed UTF-8 sequence at s[i] (RFC 3629: no overlong forms, no surrogates,
+// nothing above U+10FFFF), 0 when there is none. What toml++ enforces on a document, checked here
+// on the text that does not pass through it.
+size_t utf8_sequence(const std::string& s, size_t i) {
+  const size_t n = s.size();
+  const auto c = static_cast<unsigned char>(s[i]);
+  size_t len;
+  unsigned lo = 0x80, hi = 0xBF;  // range of the second byte
+  if (c < 0x80) len = 1;
+  else if (c >= 0xC2 && c <= 0xDF) len = 2;
+  else if (c >= 0xE0 && c <= 0xEF) {
+    len = 3;
+    if (c == 0xE0) lo = 0xA0;
+    if (c == 0xED) hi = 0x9F;
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    len = 4;
+    if (c == 0xF0) lo = 0x90;
+    if (c == 0xF4) hi = 0x8F;
+  } else return 0;
+  if (n - i < len) return 0;
+  for (size_t k = 1; k < len; ++k) {
+    const auto b = static_cast<unsigned char>(s[i + k]);
+    if (k == 1 ? (b < lo || b > hi) : (b < 0x80 || b > 0xBF)) return 0;
+  }
+  return len;
+}
+
+bool is_utf8(const std::string& s) {
+  for (size_t i = 0, len; i < s.size(); i += len)
+    if ((len = utf8_sequence(s, i)) == 0) return false;
+  return true;
+}
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return {};
+  const auto e = s.find_last_not_of(" \t");
+  return s.substr(b, e - b + 1);
+}
+
+// Interprets a parsed scene document; every error names the file and the dotted key.
+class Interpreter {
+ public:
+  Interpreter(std::string file, std::set<std::string> overridden)
+      : file_(std::move(file)), overridden_(std::move(overridden)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& why) const {
+    throw SceneError(file_ + ": " + key + ": " + why);
+  }
+
+  // The one form of every range error: "KEY: VALUE is out of range (expected RANGE)".
+  [[noreturn]] void out_of_range(const std::string& key, double v, const std::string& expected) const {
+    fail(key, num(v) + " is out of range (expected " + expected + ")");
+  }
+
+  void apply_override(toml::table& root, const std::string& text) const {
+    const auto eq = text.find('=');
+    const std::string key = trim(text.substr(0, eq));
+    if (eq == std::string::npos || key.empty())
+      fail("--set", "malformed override \"" + text + "\" (expected KEY=VALUE)");
+    std::vector<std::string> parts;
+    std::stringstream ss(key);
+    for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
+    if (key.back() == '.' || parts.empty() ||
+        !std::all_of(parts.begin(), parts.end(), is_bare_key))
+      fail("--set", "malformed key \"" + key + "\" in \"" + text + "\" (expected dotted bare keys, e.g. contact.mu)");
+
+    const std::string value_text = trim(text.substr(eq + 1));
+    toml::table parsed;
+    bool is_toml = false;
+    try {
+      parsed = toml::parse("v = " + value_text);
+      is_toml = parsed.size() == 1 && parsed.contains("v");
+    } catch (const toml::parse_error&) {
+    }
+    if (!is_toml) {
+      // A bare word becomes a TOML string, which must be UTF-8; the run's records are JSON,
+      // whose writer would otherwise throw only after the whole run.
+      if (!is_utf8(value_text)) fail("--set", "the value of " + key + " is not valid UTF-8");
+      parsed = toml::table{};
+      parsed.insert("v", value_text);
+    }
+
+    toml::table* tbl = &root;
+    std::string walked;
+    for (size_t i = 0; i + 1 < parts.size(); ++i) {
+      walked = join_path(walked, parts[i]);
+      toml::node* n = tbl->get(parts[i]);
+      if (!n) n = &tbl->insert(parts[i], toml::table{}).first->second;
+      tbl = n->as_table();
+      if (!tbl) fail("--set", "cannot set " + key + ": " + walked + " is not a table");
+    }
+    parsed.get("v")->visit([&](auto& v) { tbl->insert_or_assign(parts.back(), std::move(v)); });
+  }
+
+  Scene interpret(const toml::table& root, const std::string& default_name) {
+    Scene s;
+    keys(root, "", {"name", "description", "gravity", "notes", "body", "contact", "initial", "run", "engines"});
+    const auto name = opt_string(root, "", "name");
+    s.name = name.value_or(default_name);
+    if (!is_valid_name(s.name))
+      fail("name", "\"" + s.name + "\"" + (name ? "" : " (the file's stem)") + " is not a usable name (" + kNameRule +
+                       "; it names output directories)");
+    s.description = opt_string(root, "", "description").value_or("");
+    if (s.description.find_first_of("\r\n") != std::string::npos) fail("description", "must be one line");
+    s.gravity = need_number(root, "", "gravity");
+    if (!(s.gravity > 0)) out_of_range("gravity", s.gravity, "gravity > 0");
+    if (const toml::node* n = root.get("notes")) s.notes = read_notes(*n);
+
+    // contact first: whether a stem exists decides which body keys are required.
+    read_contact(need_table(root, "", "contact"), s.contact);
+    read_body(need_table(root, "", "body"), s);
+    read_initial(need_table(root, "", "initial"), s);
+    read_run(need_table(root, "", "run"), s.run);
+    if (const toml::node* e = root.get("engines")) read_engines(*e, s);
+    return s;
+  }
+
+ private:
+  void keys(const toml::table& t, const std::string& prefix, std::initializer_list<const char*> allowed) const {
+    for (auto&& [k, v] : t) {
+      (void)v;
+      const std::string key(k.str());
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+        std::string list;
+        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        const std::string path = join_path(prefix, key);
+        fail(path, "unknown key (expected one of: " + list + ")" +
+                       (overridden_.count(path) ? "; it was set with --set" : ""));
+      }
+    }
+  }
+
+  const toml::table& need_table(const toml::table& t, const std::string& prefix, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) fail(join_path(prefix, key), "missing (required table)");
+    const toml::table* tbl = n->as_table();
+    if (!tbl) fail(join_path(prefix, key), "expected a table, got " + toml_value_text(*n));
+    return *tbl;
+  }
+
+  double to_number(const toml::node& n, const std::string& path) const {
+    double v;
+    if (const auto* f = n.as_floating_point()) v = f->get();
+    else if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
+    else fail(path, "expected a number, got " + toml_value_text(n));
+    if (!std::isfinite(v)) fail(path, "must be a finite number, got " + num(v));
+    return v;
+  }
+
+  std::optional<double> opt_number(const toml::table& t, const std::string& prefix, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    return to_number(*n, join_path(prefix, key));
+  }
+
+  double need_number(const toml::table& t, const std::string& prefix, const char* key) const {
+    auto v = opt_number(t, prefix, key);
+    if (!v) fail(join_path(prefix, key), "missing (required)");
+    return *v;
+  }
+
+  double need_positive(const toml::table& t, const std::string& prefix, const char* key) const {
+    const double v = need_number(t, prefix, key);
+    if (!(v > 0)) out_of_range(join_path(prefix, key), v, std::string(key) + " > 0");
+    return v;
+  }
+
+  std::optional<bool> opt_bool(const toml::table& t, const std::string& prefix, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    const auto* b = n->as_boolean();
+    if (!b) fail(join_path(prefix, key), "expected true or false, got " + toml_value_text(*n));
+    return b->get();
+  }
+
+  std::optional<std::string> opt_string(const toml::table& t, const std::string& prefix, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    const auto* s = n->as_string();
+    if (!s) fail(join_path(prefix, key), "expected a string, got " + toml_value_text(*n));
+    return s->get();
+  }
+
+  std::optional<std::vector<double>> opt_numbers(const toml::table& t, const std::string& prefix, const char* key,
+                                                  size_t count) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    const std::string path = join_path(prefix, key);
+    const auto* a = n->as_array();
+    if (!a || a->size() != count)
+      fail(path, "expected an array of " + std::to_string(count) + " numbers, got " +
+                     (a ? "an array of " + std::to_string(a->size()) : toml_value_text(*n)));
+    std::vector<double> out;
+    for (size_t i = 0; i < a->size(); ++i) out.push_back(to_number(*a->get(i), path + "[" + std::to_string(i) + "]"));
+    return out;
+  }
+
+  // A coefficient that belongs to another friction law: harmless only when it is 0.
+  void must_be_zero_if_present(const toml::table& t, const char* key, const char* law) const {
+    if (auto v = opt_number(t, "contact", key); v && *v != 0.0)
+      fail(join_path("contact", key), std::string("does not apply to friction = \"") + law +
+                                          "\" (only 0 is accepted), got " + num(*v));
+  }
+
+  void read_contact(const toml::table& t, ContactSpec& c) const {
+    keys(t, "contact", {"friction", "mu", "k", "drilling", "drilling_law", "stem", "flight"});
+    const auto law = opt_string(t, "contact", "friction");
+    if (!law) fail("contact.friction", "missing (required: rolling, viscous, gliding, coulomb or none)");
+    if (*law == "rolling") c.friction = FrictionLaw::Rolling;
+    else if (*law == "viscous") c.friction = FrictionLaw::Viscous;
+    else if (*law == "gliding") c.friction = FrictionLaw::Gliding;
+    else if (*law == "coulomb") c.friction = FrictionLaw::Coulomb;
+    else if (*law == "none") c.friction = FrictionLaw::None;
+    else fail("contact.friction", "unknown law \"" + *law + "\" (expected rolling, viscous, gliding, coulomb or none)");
+
+    if (c.friction == FrictionLaw::Coulomb || c.friction == FrictionLaw::Gliding) {
+      // Coulomb: dimensionless; gliding: F_t = -mu F_n v_C, mu in s/m (Rutstam 2012).
+      c.mu = need_number(t, "contact", "mu");
+      // No upper bound on mu or k: large values are how a scene approaches rolling.
+      if (!(c.mu >= 0)) out_of_range("contact.mu", c.mu, "mu >= 0");
+    } else {
+      must_be_zero_if_present(t, "mu", law->c_str());
+    }
+    if (c.friction == FrictionLaw::Viscous) {
+      c.k = need_number(t, "contact", "k");
+      if (!(c.k >= 0)) out_of_range("contact.k", c.k, "k >= 0");
+    } else {
+      must_be_zero_if_present(t, "k", law->c_str());
+    }
+    if (c.friction == FrictionLaw::None) {
+      must_be_zero_if_present(t, "drilling", law->c_str());
+    } else {
+      c.drilling = opt_number(t, "contact", "drilling").value_or(0.0);
+      if (!(c.drilling >= 0)) out_of_range("contact.drilling", c.drilling, "drilling >= 0");
+    }
+    // The coupled Coulomb-Contensou law bounds the Coulomb force and the drilling torque
+    // jointly: it needs both bounds (mu > 0, mu_d > 0) and the Coulomb law to couple to.
+    const std::string drill_law = opt_string(t, "contact", "drilling_law").value_or("decoupled");
+    if (drill_law == "decoupled") {
+      c.drilling_law = DrillingLaw::Decoupled;
+    } else if (drill_law == "coupled") {
+      c.drilling_law = DrillingLaw::Coupled;
+      if (c.friction != FrictionLaw::Coulomb)
+        fail("contact.drilling_law", std::string("\"coupled\" needs friction = \"coulomb\" (it bounds the Coulomb force and the "
+                                     "drilling torque jointly), got friction = \"") + *law + "\"");
+      if (!(c.mu > 0)) fail("contact.drilling_law", "\"coupled\" needs contact.mu > 0, got " + num(c.mu));
+      if (!(c.drilling > 0)) fail("contact.drilling_law", "\"coupled\" needs contact.drilling > 0 (mu_d, the bound of the drilling torque per unit normal force), got " + num(c.drilling));
+    } else {
+      fail("contact.drilling_law", "unknown law \"" + drill_law + "\" (expected decoupled or coupled)");
+    }
+    c.stem = opt_bool(t, "contact", "stem").value_or(true);
+    c.flight = opt_bool(t, "contact", "flight").value_or(false);
+  }
+
+  void read_body(const toml::table& t, Scene& s) const {
+    static const char* const direct[] = {"mass", "com_offset", "inertia_transverse", "inertia_axial"};
+    keys(t, "body", {"sphere_radius", "stem_radius", "stem_length", "truncation_height", "density", "mass_model",
+                     "mass", "com_offset", "inertia_transverse", "inertia_axial"});
+    BodyGeometry& b = s.body;
+    b.sphere_radius = need_positive(t, "body", "sphere_radius");
+    if (s.contact.stem) {
+      b.stem_radius = need_positive(t, "body", "stem_radius");
+      b.stem_length = need_positive(t, "body", "stem_length");
+    } else {
+      // Without stem contact the stem may still carry mass, so its size is used when given.
+      if (t.contains("stem_radius")) b.stem_radius = need_positive(t, "body", "stem_radius");
+      if (t.contains("stem_length")) b.stem_length = need_positive(t, "body", "stem_length");
+    }
+    b.truncation_height = need_number(t, "body", "truncation_height");
+    if (!(b.truncation_height > 0 && b.truncation_height <= b.sphere_radius))
+      out_of_range("body.truncation_height", b.truncation_height,
+                   "0 < truncation_height <= sphere_radius = " + num(b.sphere_radius));
+    const auto problems = geometry_problems(b, s.contact.stem);
+    if (!problems.empty()) throw SceneError(body_message(problems.front()));
+
+    size_t given = 0;
+    for (const char* k : direct) given += t.contains(k) ? 1 : 0;
+    if (given == 4) {
+      for (const char* k : {"density", "mass_model"})
+        if (t.contains(k))
+          fail(join_path("body", k), "not used when mass, com_offset, inertia_transverse and inertia_axial are given; remove it");
+      b.mass_model = MassModel::Given;
+      b.density = 0.0;
+      MassProperties& m = s.mass;
+      m.mass = need_positive(t, "body", "mass");
+      m.com_offset = need_number(t, "body", "com_offset");
+      m.inertia_transverse = need_positive(t, "body", "inertia_transverse");
+      m.inertia_axial = need_positive(t, "body", "inertia_axial");
+      if (!(std::abs(m.com_offset) < b.sphere_radius))
+        out_of_range("body.com_offset", m.com_offset,
+                     "-R < com_offset < R, R = sphere_radius = " + num(b.sphere_radius));
+      if (m.inertia_axial > 2 * m.inertia_transverse)
+        out_of_range("body.inertia_axial", m.inertia_axial,
+                     "inertia_axial <= 2 inertia_transverse = " + num(2 * m.inertia_transverse) +
+                         ": the triangle inequality of an axisymmetric body");
+      return;
+    }
+    if (given > 0) {
+      for (const char* k : direct)
+        if (!t.contains(k))
+          fail(join_path("body", k), "missing: mass properties given directly need all of mass, com_offset, "
+                                     "inertia_transverse and inertia_axial");
+    }
+    b.density = need_positive(t, "body", "density");
+    const auto model = opt_string(t, "body", "mass_model");
+    if (!model) fail("body.mass_model", "missing (required with density: \"solid\" or \"seed\")");
+    if (*model == "solid") b.mass_model = MassModel::Solid;
+    else if (*model == "seed") b.mass_model = MassModel::Seed;
+    else fail("body.mass_model", "unknown model \"" + *model + "\" (expected \"solid\" or \"seed\")");
+    try {
+      s.mass = compute_mass_properties(b);
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(body_message(e.what()));
+    }
+  }
+
+  // Messages from the mass-properties code start with "QUANTITY: "; when QUANTITY is a body
+  // key it becomes the dotted key, otherwise the whole message is the reason for "body".
+  std::string body_message(const std::string& what) const {
+    static const std::set<std::string> body_keys = {"sphere_radius", "stem_radius", "stem_length",
+                                                    "truncation_height", "density", "mass_model",
+                                                    "mass", "com_offset", "inertia_transverse",
+                                                    "inertia_axial"};
+    const auto colon = what.find(": ");
+    const bool keyed = colon != std::string::npos && body_keys.count(what.substr(0, colon));
+    return file_ + ": body" + (keyed ? "." : ": ") + what;
+  }
+
+  // One line each: a note is printed as a line of `tippe run` and a list item of a report.
+  std::vector<std::string> read_notes(const toml::node& n) const {
+    const auto* a = n.as_array();
+    if (!a) fail("notes", "expected an array of strings, got " + toml_value_text(n));
+    std::vector<std::string> out;
+    for (size_t i = 0; i < a->size(); ++i) {
+      const std::string key = "notes[" + std::to_string(i) + "]";
+      const auto* str = a->get(i)->as_string();
+      if (!str) fail(key, "expected a string, got " + toml_value_text(*a->get(i)));
+      if (str->get().empty() || str->get().find_first_of("\r\n") != std::string::npos)
+        fail(key, "must be one non-empty line");
+      out.push_back(str->get());
+    }
+    return out;
+  }
+
+  void read_initial(const toml::table& t, Scene& s) const {
+    keys(t, "initial", {"tilt", "orientation", "position", "spin", "omega", "velocity", "omega_along_contact", "height"});
+    InitialSpec& in = s.initial;
+    const auto orientation = opt_numbers(t, "initial", "orientation", 4);
+    if (orientation) {
+      if (t.contains("tilt")) fail("initial.orientation", "give either tilt or orientation, not both");
+      // A unit quaternion (w, x, y, z); 1e-9 admits one written with 10 significant digits and
+      // refuses one that is not meant as a rotation.
+      const double norm = std::sqrt((*orientation)[0] * (*orientation)[0] + (*orientation)[1] * (*orientation)[1] +
+                                    (*orientation)[2] * (*orientation)[2] + (*orientation)[3] * (*orientation)[3]);
+      if (!(std::abs(norm - 1.0) <= 1e-9))
+        fail("initial.orientation", "must be a unit quaternion [w, x, y, z], got norm " + num(norm));
+      in.orientation_given = true;
+      std::copy(orientation->begin(), orientation->end(), in.orientation.begin());
+    } else {
+      in.tilt = need_number(t, "initial", "tilt");
+      if (!(in.tilt >= 0 && in.tilt <= kPi)) out_of_range("initial.tilt", in.tilt, "0 <= tilt <= pi = " + num(kPi) + " rad");
+    }
+    if (const auto p = opt_numbers(t, "initial", "position", 2)) std::copy(p->begin(), p->end(), in.position.begin());
+    const auto spin = opt_number(t, "initial", "spin");
+    const auto omega = opt_numbers(t, "initial", "omega", 3);
+    if (spin && omega) fail("initial.omega", "give either spin or omega, not both");
+    if (!spin && !omega) fail("initial.spin", "missing (give spin or omega)");
+    if (spin) in.spin = *spin;
+    if (omega) {
+      in.omega_given = true;
+      std::copy(omega->begin(), omega->end(), in.omega_B.begin());
+    }
+    if (const auto v = opt_numbers(t, "initial", "velocity", 2)) {
+      if (s.contact.friction == FrictionLaw::Rolling)
+        fail("initial.velocity", "not allowed with friction = \"rolling\": the velocity of G is derived for rolling "
+                                 "(v_G = R_C x omega)");
+      in.velocity_given = true;
+      std::copy(v->begin(), v->end(), in.velocity.begin());
+    }
+    in.omega_along_contact = opt_bool(t, "initial", "omega_along_contact").value_or(false);
+    if (in.omega_along_contact && in.omega_given)
+      fail("initial.omega_along_contact", "takes its magnitude from spin; it cannot be combined with omega");
+    in.height = opt_number(t, "initial", "height").value_or(0.0);
+    if (!(in.height >= 0)) out_of_range("initial.height", in.height, "height >= 0");
+    if (in.height > 0 && !s.contact.flight)
+      fail("initial.height", "a start above the floor needs contact.flight = true");
+  }
+
+  void read_run(const toml::table& t, RunSpec& r) const {
+    keys(t, "run", {"duration", "sample_interval", "rtol", "atol", "method", "self_check"});
+    r.duration = need_positive(t, "run", "duration");
+    r.sample_interval = need_number(t, "run", "sample_interval");
+    if (!(r.sample_interval > 0 && r.sample_interval <= r.duration))
+      out_of_range("run.sample_interval", r.sample_interval, "0 < sample_interval <= duration = " + num(r.duration));
+    if (r.duration / r.sample_interval + 1 > kMaxSamples)
+      fail("run.sample_interval",
+           num(r.sample_interval) + " gives " + num(r.duration / r.sample_interval + 1) + " samples, up to " +
+               num(std::ceil((r.duration / r.sample_interval + 1) * kTrajectoryRowMax / 1048576.0)) +
+               " MiB of trajectory, over the budget of " + num(kMaxTrajectoryBytes / 1048576.0) +
+               " MiB (expected sample_interval >= " + num(r.duration / (std::floor(kMaxSamples) - 1)) + ")");
+    r.rtol = opt_number(t, "run", "rtol").value_or(r.rtol);
+    if (!(r.rtol >= kMinRtol && r.rtol <= kMaxRtol))
+      out_of_range("run.rtol", r.rtol, num(kMinRtol) + " <= rtol <= " + num(kMaxRtol));
+    r.atol = opt_number(t, "run", "atol").value_or(r.atol);
+    // atol is in the scene's own units, so only its sign is certain; the bound of 1 is a
+    // judgement: it would swamp the states of every shipped scene (of order 1 or smaller).
+    if (!(r.atol > 0 && r.atol <= 1)) out_of_range("run.atol", r.atol, "0 < atol <= 1");
+    if (const toml::node* m = t.get("method")) {
+      const auto* str = m->as_string();
+      if (!str) fail("run.method", "expected a string, got " + toml_value_text(*m));
+      r.method = str->get();
+      if (r.method != "bulirsch_stoer" && r.method != "dopri5" && r.method != "rosenbrock4")
+        fail("run.method", "must be \"bulirsch_stoer\", \"dopri5\" or \"rosenbrock4\", got \"" + r.method + "\"");
+    }
+    r.self_check = opt_bool(t, "run", "self_check").value_or(true);
+    for (const char* k : {"rtol", "atol", "method", "self_check"})
+      if (t.contains(k)) r.alias_keys.push_back(k);
+  }
+
+  SettingValue to_setting(const toml::node& n, const std::string& path) const {
+    if (const auto* b = n.as_boolean()) return b->get();
+    if (const auto* i = n.as_integer()) return static_cast<long long>(i->get());
+    if (n.is_floating_point()) return to_number(n, path);
+    if (const auto* s = n.as_string()) return s->get();
+    if (const auto* a = n.as_array()) {
+      std::vector<double> out;
+      for (size_t i = 0; i < a->size(); ++i) out.push_back(to_number(*a->get(i), path + "[" + std::to_string(i) + "]"));
+      return out;
+    }
+    fail(path, "unsupported value (" + toml_value_text(n) +
+                   "; expected a boolean, number, string or array of numbers)");
+  }
+
+  void read_engines(const toml::node& node, Scene& s) const {
+    const auto* t = node.as_table();
+    if (!t) fail("engines", "expected a table of [engines.NAME] tables, got " + toml_value_text(node));
+    for (auto&& [name, table] : *t) {
+      const std::string prefix = "engines." + std::string(name.str());
+      const auto* et = table.as_table();
+      if (!et) fail(prefix, "expected a table, got " + toml_value_text(table));
+      auto& dst = s.engines[std::string(name.str())];
+      for (auto&& [k, v] : *et) dst[std::string(k.str())] = to_setting(v, prefix + "." + std::string(k.str()));
+    }
+    resolve_mujoco_model(s);
+    try {
+      validate_engine_settings(s);
+      if (reference_engine().adopt) reference_engine().adopt(s);
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(file_ + ": " + e.what());
+    }
+  }
+
+  // engines.mujoco.model names the user's own MJCF, relative to the scene file: resolved here,
+  // read once (its bytes join the scene's content hash, so a changed model is a changed scene)
+  // and checked by validate_engine_settings (MuJoCo compiles it).
+  void resolve_mujoco_model(Scene& s) const {
+    auto engine = s.engines.find("mujoco");
+    if (engine == s.engines.end()) return;
+    auto it = engine->second.find("model");
+    if (it == engine->second.end()) return;
+    const auto* path = std::get_if<std::string>(&it->second);
+    if (!path) fail("engines.mujoco.model", "expected a string (a path to an MJCF file, relative to the scene file)");
+    if (path->empty()) fail("engines.mujoco.model", "is empty (expected a path to an MJCF file)");
+    std::filesystem::path p(*path);
+    if (p.is_relative()) p = std::filesystem::path(file_).parent_path() / p;
+    std::error_code ec;
+    if (std::filesystem::is_directory(p, ec)) fail("engines.mujoco.model", p.string() + ": is a directory");
+    try {
+      model_bytes_ = read_file_text(p.string(), kMaxInputFileBytes);
+    } catch (const std::runtime_error& e) {
+      fail("engines.mujoco.model", e.what());
+    }
+    it->second = p.lexically_normal().string();
+    has_model_ = true;
+  }
+
+ public:
+  bool has_model() const { return has_model_; }
+  const std::string& model_bytes() const { return model_bytes_; }
+
+ private:
+  std::string file_;
+  std::set<std::string> overridden_;
+  mutable std::string model_bytes_;
+  mutable bool has_model_ = false;
+};
+
+}  // namespace
+
+const char* const kNameRule = "letters, digits, '.', '_', '-'";
+
+bool is_valid_name(const std::string& n) {
+  return !n.empty() && n != "." && n != ".." && std::all_of(n.begin(), n.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+           c == '.';
+  });
+}
+
+bool is_valid_utf8(const std::string& s) { return is_utf8(s); }
+
+std::string utf8_replaced(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (size_t i = 0; i < s.size();) {
+    const size_t len = utf8_sequence(s, i);
+    if (len == 0) {
+      out += "\xEF\xBF\xBD";  // U+FFFD
+      ++i;
+    } else {
+      out.append(s, i, len);
+      i += len;
+    }
+  }
+  return out;
+}
+
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::string text;
+  try {
+    text = read_file_text(path, kMaxInputFileBytes);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
+  }
+  return parse_scene_text(text, path, overrides);
+}
+
+Scene parse_scene_text(const std::string& text, const std::string& file_label,
+                       const std::vector<std::string>& overrides) {
+  // The label is the scene's source_file in every JSON record: checked before any work is done.
+  if (!is_utf8(file_label)) throw SceneError(file_label + ": cannot read: the path is not valid UTF-8");
+  toml::table root;
+  try {
+    root = toml::parse(text, file_label);
+  } catch (const toml::parse_error& e) {
+    throw SceneError(file_label + ":" + std::to_string(e.source().begin.line) + ":" +
+                     std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
+  }
+
+  std::set<std::string> overridden;
+  for (const auto& o : overrides) overridden.insert(trim(o.substr(0, o.find('='))));
+  Interpreter interp(file_label, overridden);
+  for (const auto& o : overrides) interp.apply_override(root, o);
+
+  Scene s = interp.interpret(root, std::filesystem::path(file_label).stem().string());
+  s.source_file = file_label;
+  // A scene that runs a user's MJCF hashes its bytes too: a changed model is a changed scene.
+  s.content_hash = interp.has_model() ? fnv1a64_hex(text + std::string(1, '\0') + "engines.mujoco.model" +
+                                                         std::string(1, '\0') + interp.model_bytes(),
+                                                     overrides)
+                                      : fnv1a64_hex(text, overrides);
+  return s;
+}
+
+nlohmann::json setting_to_json(const SettingValue& value) {
+  return std::visit([](const auto& v) { return nlohmann::json(v); }, value);
+}
+
+nlohmann::json scene_to_json(const Scene& s) {
+  using nlohmann::json;
+  json engines = json::object();
+  for (const auto& [engine, table] : s.engines) {
+    json t = json::object();
+    for (const auto& [k, v] : table) t[k] = setting_to_json(v);
+    engines[engine] = t;
+  }
+  json out{
+      {"name", s.name},
+      {"description", s.description},
+      {"source_file", s.source_file},
+      {"content_hash", s.content_hash},
+      {"gravity", s.gravity},
+      {"body",
+       {{"sphere_radius", s.body.sphere_radius},
+        {"stem_radius", s.body.stem_radius},
+        {"stem_length", s.body.stem_length},
+        {"truncation_height", s.body.truncation_height},
+        {"density", s.body.density},
+        {"mass_model", to_string(s.body.mass_model)}}},
+      {"mass_properties",
+       {{"mass", s.mass.mass},
+        {"com_offset", s.mass.com_offset},
+        {"inertia_transverse", s.mass.inertia_transverse},
+        {"inertia_axial", s.mass.inertia_axial}}},
+      {"contact",
+       {{"friction", to_string(s.contact.friction)},
+        {"mu", s.contact.mu},
+        {"k", s.contact.k},
+        {"drilling", s.contact.drilling},
+        {"drilling_law", to_string(s.contact.drilling_law)},
+        {"stem", s.contact.stem},
+        {"flight", s.contact.flight}}},
+      {"initial",
+       {{"tilt", s.initial.tilt},
+        {"omega_given", s.initial.omega_given},
+        {"spin", s.initial.spin},
+        {"omega", s.initial.omega_B},
+        {"velocity_given", s.initial.velocity_given},
+        {"velocity", s.initial.velocity},
+        {"omega_along_contact", s.initial.omega_along_contact},
+        {"height", s.initial.height}}},
+      {"run",
+       {{"duration", s.run.duration},
+        {"sample_interval", s.run.sample_interval},
+        {"rtol", s.run.rtol},
+        {"atol", s.run.atol},
+        {"method", s.run.method},
+        {"self_check", s.run.self_check}}},
+      {"engines", engines},
+  };
+  // Written only when used, so that the JSON (and the physics hash) of every other scene stays as it was.
+  if (s.initial.orientation_given) out["initial"]["orientation"] = s.initial.orientation;
+  if (s.initial.position[0] != 0.0 || s.initial.position[1] != 0.0) out["initial"]["position"] = s.initial.position;
+  if (!s.notes.empty()) out["notes"] = s.notes;
+  return out;
+}
+
+}  // namespace tippe

@@ -1,0 +1,520 @@
+// Run records: running a scene on one simulator, its summary numbers, JSON and CSV writers, atomic files.
+#include "records/records.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "mass_properties.h"
+#include "io/interrupt.h"
+#include "io/provenance.h"
+#include "io/scene_io.h"
+
+namespace tippe {
+
+namespace {
+
+using nlohmann::json;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Floor of the relative-drift denominator: J = 0 exactly (no spin) must not divide by zero.
+constexpr double kTinyJ = 1e-300;
+
+json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json number(const std::optional<double>& v) { return v ? number(*v) : json(nullptr); }
+
+double get_number(const json& j, const char* key) {
+  const json& v = j.at(key);
+  return v.is_null() ? kNaN : v.get<double>();
+}
+
+std::optional<double> get_optional(const json& j, const char* key) {
+  const json& v = j.at(key);
+  if (v.is_null()) return std::nullopt;
+  return v.get<double>();
+}
+
+std::string errno_text() { return std::strerror(errno); }
+
+std::string temp_name(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
+
+}  // namespace
+
+Provenance current_provenance() {
+  const BuildInfo b = build_info();
+  Provenance p{b.git_commit, b.compiler, b.cxx_flags, {}, {}};
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  p.date = date;
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) == 0) p.hostname = host;
+  return p;
+}
+
+void SampleSummary::add(const Observation& o, bool contact_switched) {
+  if (n_ == 0) {
+    first_ = o;
+    min_fn_ = o.normal_force;
+  }
+  last_ = o;
+  min_fn_ = std::min(min_fn_, o.normal_force);
+  ++n_;
+
+  if (contact_switched) run_surface_ = Surface::None;
+  if (o.surface != Surface::Ball && o.surface != Surface::Stem) {
+    run_surface_ = Surface::None;
+    return;
+  }
+  double drift = 0.0;
+  if (o.surface != run_surface_) {
+    run_surface_ = o.surface;
+    run_j0_ = o.jellett;
+  } else {
+    drift = std::abs(o.jellett - run_j0_) / std::max(std::abs(run_j0_), kTinyJ);
+  }
+  auto& slot = o.surface == Surface::Ball ? drift_ball_ : drift_stem_;
+  slot = std::max(slot.value_or(0.0), drift);
+}
+
+void SampleSummary::fill(RunRecord& r) const {
+  r.samples = n_;
+  if (n_ == 0) {
+    r.final_time = r.final_tilt = r.energy_initial = r.energy_final = r.jellett_initial = kNaN;
+    r.min_normal_force = r.jellett_max_relative_drift = kNaN;
+    r.jellett_drift_ball = r.jellett_drift_stem = std::nullopt;
+    return;
+  }
+  r.final_time = last_.state.t;
+  r.final_tilt = last_.theta;
+  r.energy_initial = first_.energy;
+  r.energy_final = last_.energy;
+  r.jellett_initial = first_.jellett;
+  r.min_normal_force = min_fn_;
+  r.jellett_drift_ball = drift_ball_;
+  r.jellett_drift_stem = drift_stem_;
+  if (drift_ball_ || drift_stem_)
+    r.jellett_max_relative_drift = std::max(drift_ball_.value_or(0.0), drift_stem_.value_or(0.0));
+  else
+    r.jellett_max_relative_drift = kNaN;
+}
+
+RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, ProgressFn progress) {
+  RunRecord r;
+  r.provenance = current_provenance();
+  r.scene_name = scene.name;
+  r.scene_file = scene.source_file;
+  r.scene_hash = scene.content_hash;
+  r.scene_spec = scene_to_json(scene);
+  r.engine = sim.engine();
+  r.engine_version = sim.version();
+  r.mass = scene.mass;
+  r.inversion_possible = inversion_possible(scene.mass, scene.body.sphere_radius);
+
+  const double dt = scene.run.sample_interval, T = scene.run.duration;
+  // The tolerance keeps e.g. 8 / 0.001 = 7999.999... from losing its last grid point.
+  const long long n = static_cast<long long>(std::floor(T / dt + 1e-9));
+  SampleSummary summary;
+  double last_t = -std::numeric_limits<double>::infinity();
+  size_t events_seen = 0;
+  auto emit = [&](const Observation& o) {
+    // The interface has no "events since": copying the list per sample is cheap next to a step.
+    const std::vector<Event> events = sim.events();
+    bool switched = false;
+    for (size_t i = events_seen; i < events.size(); ++i) switched = switched || events[i].name == "switch";
+    events_seen = events.size();
+    summary.add(o, switched);
+    if (sink) sink->write(o);
+    last_t = o.state.t;
+    if (progress) progress(o.state.t, T);
+    // Between samples a deferred SIGINT or SIGTERM ends the run (see interrupt.h).
+    check_interrupted();
+  };
+  emit(sim.observe());
+  for (long long k = 1; k <= n && sim.status() == RunStatus::Ok; ++k) {
+    double t = static_cast<double>(k) * dt;
+    if (k == n && std::abs(t - T) <= 1e-9 * dt) t = T;
+    sim.advance_to(t);
+    const Observation o = sim.observe();
+    // A simulator that stopped may report the state it stopped at, which can repeat the last sample.
+    if (sim.status() == RunStatus::Ok || o.state.t > last_t) emit(o);
+  }
+  summary.fill(r);
+
+  r.status = to_string(sim.status());
+  r.status_time = sim.status_time();
+  r.status_detail = sim.status_detail();
+  r.events = sim.events();
+  r.settings = sim.settings();
+  r.notes = sim.notes();
+  r.work = sim.work();
+  for (const Event& e : r.events) {
+    if (e.name == "inversion" && !r.inversion_time) r.inversion_time = e.time;
+    if (e.name == "stem_contact" && !r.stem_contact_time) r.stem_contact_time = e.time;
+  }
+  return r;
+}
+
+RunRecord run_scene(const Scene& scene, const std::string& engine, SampleSink* sink, ProgressFn progress) {
+  auto sim = make_simulator(engine, scene);
+  return run_simulator(*sim, scene, sink, std::move(progress));
+}
+
+json to_json(const RunRecord& r) {
+  json events = json::array();
+  for (const Event& e : r.events)
+    events.push_back({{"name", e.name}, {"time", number(e.time)}, {"detail", e.detail}, {"value", number(e.value)}});
+  json settings = json::object();
+  for (const auto& [k, v] : r.settings) settings[k] = v;
+  return json{
+      {"format", kRunRecordFormat},
+      {"scene", r.scene_name},
+      {"scene_file", r.scene_file},
+      {"scene_hash", r.scene_hash},
+      {"scene_spec", r.scene_spec},
+      {"engine", r.engine},
+      {"engine_version", r.engine_version},
+      {"status", r.status},
+      {"status_time", number(r.status_time)},
+      {"status_detail", r.status_detail},
+      {"inversion_time", number(r.inversion_time)},
+      {"stem_contact_time", number(r.stem_contact_time)},
+      {"samples", r.samples},
+      {"final_time", number(r.final_time)},
+      {"final_tilt", number(r.final_tilt)},
+      {"energy_initial", number(r.energy_initial)},
+      {"energy_final", number(r.energy_final)},
+      {"jellett_initial", number(r.jellett_initial)},
+      {"jellett_max_relative_drift", number(r.jellett_max_relative_drift)},
+      {"jellett_drift_ball", number(r.jellett_drift_ball)},
+      {"jellett_drift_stem", number(r.jellett_drift_stem)},
+      {"min_normal_force", number(r.min_normal_force)},
+      {"mass_properties",
+       {{"mass", number(r.mass.mass)},
+        {"com_offset", number(r.mass.com_offset)},
+        {"inertia_transverse", number(r.mass.inertia_transverse)},
+        {"inertia_axial", number(r.mass.inertia_axial)}}},
+      {"inversion_possible", r.inversion_possible},
+      {"work",
+       {{"steps", r.work.steps},
+        {"rhs_evaluations", r.work.rhs_evaluations},
+        {"solver_iterations", r.work.solver_iterations},
+        {"wall_seconds", number(r.work.wall_seconds)},
+        {"cpu_seconds", number(r.work.cpu_seconds)}}},
+      {"events", events},
+      {"settings", settings},
+      {"notes", r.notes},
+      {"provenance", to_json(r.provenance)},
+  };
+}
+
+json to_json(const Provenance& p) {
+  return {{"git_commit", p.git_commit},
+          {"compiler", p.compiler},
+          {"cxx_flags", p.cxx_flags},
+          {"date", p.date},
+          {"hostname", p.hostname}};
+}
+
+Provenance provenance_from_json(const json& p) {
+  return {p.at("git_commit").get<std::string>(), p.at("compiler").get<std::string>(),
+          p.at("cxx_flags").get<std::string>(), p.at("date").get<std::string>(), p.at("hostname").get<std::string>()};
+}
+
+long long json_integer(const json& j, const char* key) {
+  const json& v = j.at(key);
+  if (!v.is_number_integer())
+    throw json::type_error::create(302, std::string(key) + ": expected an integer, got " +
+                                            (v.is_number_float() ? "a float" : v.type_name()), &v);
+  if (v.is_number_unsigned() &&
+      v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<long long>::max()))
+    throw json::out_of_range::create(406, std::string(key) + ": " + v.dump() + " is out of range", &v);
+  return v.get<long long>();
+}
+
+RunRecord from_json(const json& j) {
+  // Summaries written before records carried a format have none; any other format is refused.
+  if (j.contains("format") && j.at("format") != kRunRecordFormat)
+    throw json::other_error::create(
+        501, "format: unknown record format " + j.at("format").dump().substr(0, 60) + " (expected " + kRunRecordFormat + ")",
+        &j);
+  RunRecord r;
+  r.scene_name = j.at("scene").get<std::string>();
+  r.scene_file = j.at("scene_file").get<std::string>();
+  r.scene_hash = j.at("scene_hash").get<std::string>();
+  r.scene_spec = j.value("scene_spec", json());
+  r.engine = j.at("engine").get<std::string>();
+  r.engine_version = j.at("engine_version").get<std::string>();
+  r.status = j.at("status").get<std::string>();
+  r.status_time = get_number(j, "status_time");
+  r.status_detail = j.at("status_detail").get<std::string>();
+  r.inversion_time = get_optional(j, "inversion_time");
+  r.stem_contact_time = get_optional(j, "stem_contact_time");
+  r.samples = json_integer(j, "samples");
+  r.final_time = get_number(j, "final_time");
+  r.final_tilt = get_number(j, "final_tilt");
+  r.energy_initial = get_number(j, "energy_initial");
+  r.energy_final = get_number(j, "energy_final");
+  r.jellett_initial = get_number(j, "jellett_initial");
+  r.jellett_max_relative_drift = get_number(j, "jellett_max_relative_drift");
+  r.jellett_drift_ball = get_optional(j, "jellett_drift_ball");
+  r.jellett_drift_stem = get_optional(j, "jellett_drift_stem");
+  r.min_normal_force = get_number(j, "min_normal_force");
+  const json& m = j.at("mass_properties");
+  r.mass = {get_number(m, "mass"), get_number(m, "com_offset"), get_number(m, "inertia_transverse"),
+            get_number(m, "inertia_axial")};
+  r.inversion_possible = j.at("inversion_possible").get<bool>();
+  const json& w = j.at("work");
+  r.work.steps = json_integer(w, "steps");
+  r.work.rhs_evaluations = json_integer(w, "rhs_evaluations");
+  r.work.solver_iterations = json_integer(w, "solver_iterations");
+  r.work.wall_seconds = get_number(w, "wall_seconds");
+  r.work.cpu_seconds = get_number(w, "cpu_seconds");
+  for (const json& e : j.at("events"))
+    r.events.push_back({e.at("name").get<std::string>(), get_number(e, "time"), e.at("detail").get<std::string>(),
+                        get_number(e, "value")});
+  for (const auto& [k, v] : j.at("settings").items()) r.settings.emplace_back(k, v.get<std::string>());
+  r.notes = j.at("notes").get<std::vector<std::string>>();
+  r.provenance = provenance_from_json(j.at("provenance"));
+  return r;
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  const std::string tmp = temp_name(path);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw OutputError(path + ": cannot write: " + errno_text());
+  auto fail = [&](const char* what) {
+    const std::string why = errno_text();
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw OutputError(path + ": " + what + ": " + why);
+  };
+  const char* p = text.data();
+  size_t left = text.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail("cannot write");
+    }
+    p += n;
+    left -= static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0) fail("cannot sync");
+  if (::close(fd) != 0) {
+    const std::string why = errno_text();
+    ::unlink(tmp.c_str());
+    throw OutputError(path + ": cannot close: " + why);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string why = errno_text();
+    ::unlink(tmp.c_str());
+    throw OutputError(path + ": cannot rename " + tmp + ": " + why);
+  }
+}
+
+std::string read_file_text(const std::string& path, size_t max_bytes) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": cannot read: is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot read: " + errno_text());
+  // Chunks up to one byte past the bound, so that an endless file (/dev/zero) stops there.
+  std::string text;
+  char buf[1 << 16];
+  while (in) {
+    in.read(buf, static_cast<std::streamsize>(std::min(sizeof buf, max_bytes + 1 - text.size())));
+    text.append(buf, static_cast<size_t>(in.gcount()));
+    if (text.size() > max_bytes)
+      throw std::runtime_error(path + ": cannot read: larger than " + std::to_string(max_bytes) +
+                               " bytes (the bound for this kind of file)");
+  }
+  if (in.bad()) throw std::runtime_error(path + ": cannot read: " + errno_text());
+  return text;
+}
+
+const std::vector<std::string>& trajectory_columns() {
+  static const std::vector<std::string> cols = {
+      "t",        "x_G",        "y_G",        "z_G",        "vx_G",         "vy_G",       "vz_G",
+      "qw",       "qx",         "qy",         "qz",         "wx_B",         "wy_B",       "wz_B",
+      "theta",    "surface",    "x_C",        "y_C",        "z_C",          "x_C_engine", "y_C_engine",
+      "z_C_engine", "normal_force", "slip_speed", "energy", "jellett", "contact_latitude"};
+  return cols;
+}
+
+CsvTrajectoryWriter::CsvTrajectoryWriter(std::string path) : path_(std::move(path)), tmp_(temp_name(path_)) {
+  f_ = std::fopen(tmp_.c_str(), "wb");
+  if (!f_) throw OutputError(path_ + ": cannot write: " + errno_text());
+  buffer_.resize(1 << 20);
+  std::setvbuf(f_, buffer_.data(), _IOFBF, buffer_.size());
+  if (std::fputs(trajectory_csv_header().c_str(), f_) == EOF) fail("cannot write");
+}
+
+CsvTrajectoryWriter::~CsvTrajectoryWriter() {
+  if (f_) {
+    std::fclose(f_);
+    std::remove(tmp_.c_str());
+  }
+}
+
+void CsvTrajectoryWriter::fail(const std::string& what) {
+  const std::string why = errno_text();
+  if (f_) std::fclose(f_);
+  f_ = nullptr;
+  std::remove(tmp_.c_str());
+  throw OutputError(path_ + ": " + what + ": " + why);
+}
+
+size_t format_trajectory_row(const Observation& o, char* line) {
+  char* p = line;
+  char* const end = line + kTrajectoryRowMax;
+  auto put = [&](double v) {
+    if (p != line) *p++ = ',';
+    p = std::to_chars(p, end, v, std::chars_format::general, 17).ptr;
+  };
+  auto put_text = [&](const char* s) {
+    *p++ = ',';
+    while (*s) *p++ = *s++;
+  };
+  const BodyState& x = o.state;
+  const double nan = kNaN;
+  put(x.t);
+  for (int i = 0; i < 3; ++i) put(x.p_WG[i]);
+  for (int i = 0; i < 3; ++i) put(x.v_WG[i]);
+  put(x.q_WB.w());
+  put(x.q_WB.x());
+  put(x.q_WB.y());
+  put(x.q_WB.z());
+  for (int i = 0; i < 3; ++i) put(x.w_B[i]);
+  put(o.theta);
+  put_text(to_string(o.surface));
+  for (int i = 0; i < 3; ++i) put(o.p_WC[i]);
+  for (int i = 0; i < 3; ++i) put(o.engine_contact_valid ? o.p_WC_engine[i] : nan);
+  put(o.normal_force);
+  put(o.slip_speed);
+  put(o.energy);
+  put(o.jellett);
+  put(o.contact_latitude);
+  *p++ = '\n';
+  return static_cast<size_t>(p - line);
+}
+
+std::string trajectory_csv_header() {
+  std::string header;
+  for (const auto& c : trajectory_columns()) header += (header.empty() ? "" : ",") + c;
+  return header + '\n';
+}
+
+void CsvTrajectoryWriter::write(const Observation& o) {
+  if (!f_) throw std::logic_error(path_ + ": write after commit");
+  char line[kTrajectoryRowMax];
+  const size_t n = format_trajectory_row(o, line);
+  if (std::fwrite(line, 1, n, f_) != n) fail("cannot write");
+}
+
+CsvTrajectoryText::CsvTrajectoryText() : text(trajectory_csv_header()) {}
+
+void CsvTrajectoryText::write(const Observation& o) {
+  char line[kTrajectoryRowMax];
+  text.append(line, format_trajectory_row(o, line));
+}
+
+void CsvTrajectoryWriter::commit() {
+  if (!f_) throw std::logic_error(path_ + ": commit twice");
+  if (std::fflush(f_) != 0) fail("cannot write");
+  if (::fsync(::fileno(f_)) != 0) fail("cannot sync");
+  const int rc = std::fclose(f_);
+  f_ = nullptr;
+  if (rc != 0 || std::rename(tmp_.c_str(), path_.c_str()) != 0) {
+    const std::string why = errno_text();
+    std::remove(tmp_.c_str());
+    throw OutputError(path_ + ": cannot commit: " + why);
+  }
+}
+
+const std::vector<double>& CsvTrajectory::column(const std::string& name) const {
+  auto it = values.find(name);
+  if (it == values.end()) throw std::out_of_range("trajectory has no column \"" + name + "\"");
+  return it->second;
+}
+
+CsvTrajectory read_trajectory_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read: " + errno_text());
+  return parse_trajectory_csv(in, path);
+}
+
+CsvTrajectory parse_trajectory_csv(std::istream& in, const std::string& path) {
+  auto split = [](const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    if (!line.empty() && line.back() == ',') cells.emplace_back();
+    return cells;
+  };
+  auto chomp = [](std::string& s) {
+    if (!s.empty() && s.back() == '\r') s.pop_back();
+  };
+  CsvTrajectory tr;
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error(path + ":1: empty file, expected a header");
+  chomp(line);
+  tr.columns = split(line);
+  size_t surface_col = tr.columns.size();
+  std::vector<std::vector<double>*> dst;
+  for (size_t i = 0; i < tr.columns.size(); ++i) {
+    const std::string& c = tr.columns[i];
+    if (c == "surface") {
+      surface_col = i;
+      dst.push_back(nullptr);
+      continue;
+    }
+    if (tr.values.count(c)) throw std::runtime_error(path + ":1: duplicate column \"" + c + "\"");
+    dst.push_back(&tr.values[c]);
+  }
+  if (surface_col == tr.columns.size() || !tr.values.count("t"))
+    throw std::runtime_error(path + ":1: not a trajectory (needs columns t and surface)");
+
+  for (size_t lineno = 2; std::getline(in, line); ++lineno) {
+    chomp(line);
+    if (line.empty()) continue;
+    const auto cells = split(line);
+    const std::string where = path + ":" + std::to_string(lineno) + ": ";
+    if (cells.size() != tr.columns.size())
+      throw std::runtime_error(where + std::to_string(cells.size()) + " cells, header has " +
+                               std::to_string(tr.columns.size()));
+    for (size_t i = 0; i < cells.size(); ++i) {
+      if (i == surface_col) {
+        int code = -1;
+        for (Surface s : {Surface::None, Surface::Ball, Surface::Stem, Surface::Both})
+          if (cells[i] == to_string(s)) code = static_cast<int>(s);
+        if (code < 0) throw std::runtime_error(where + "unknown surface \"" + cells[i] + "\"");
+        tr.surface.push_back(code);
+        continue;
+      }
+      char* endp = nullptr;
+      const double v = std::strtod(cells[i].c_str(), &endp);
+      if (cells[i].empty() || *endp != '\0')
+        throw std::runtime_error(where + "column " + tr.columns[i] + ": not a number \"" + cells[i] + "\"");
+      dst[i]->push_back(v);
+    }
+  }
+  return tr;
+}
+
+}  // namespace tippe
