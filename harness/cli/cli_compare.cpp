@@ -48,7 +48,6 @@ int compare(const CompareCliOptions& o) {
   opts.jobs = o.jobs > 0 ? o.jobs : std::max(1, std::min(runs, static_cast<int>(std::thread::hardware_concurrency())));
   const fs::path dir = o.out.empty() ? fs::path("out") / (scene.name + "-compare") : fs::path(o.out);
   opts.cache_dir = o.no_cache ? "" : o.cache;
-  opts.plots = !o.no_plots;
   // run_comparison checks its input before it writes anything; so does this, before DIR exists.
   try {
     check_compare_input(scene, opts);
@@ -60,6 +59,7 @@ int compare(const CompareCliOptions& o) {
   OutputDir out(dir);
   opts.out_dir = out.stage(false).string();
   const Comparison c = run_comparison(scene, opts);
+  write_report(opts.out_dir, to_json(c), !o.no_plots);
   out.commit();
   print_table_and_findings(to_json(c));
   std::printf("report: %s\n", (dir / "index.html").string().c_str());

@@ -87,7 +87,6 @@ int gate(const GateCliOptions& o) {
     opts.out_dir = "";
     opts.cache_dir = o.no_cache ? "" : o.cache;
     opts.progress = true;
-    opts.plots = false;
     Comparison cmp;
     try {
       cmp = run_comparison(scene, opts);
@@ -124,7 +123,9 @@ int gate(const GateCliOptions& o) {
       so.out_dir = (fs::path(o.boundary_out) / (fs::path(b.sweep_path).stem().string() + "-" + plan.spec.hash)).string();
       so.jobs = o.jobs > 0 ? o.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
       so.restart = true;
-      so.plots = false;
+      so.write_report = [](const std::string& dir, const std::vector<SweepRecord>& records) {
+        write_sweep_report(dir, records, /*plots=*/false);
+      };
       std::fprintf(stderr, "gate %s: boundary search %s into %s\n", o.gates.c_str(), b.sweep_path.c_str(),
                    so.out_dir.c_str());
       run_search_sweep(plan, so);

@@ -58,6 +58,12 @@ int report_only(const SweepCliOptions& o) {
   return 0;
 }
 
+SweepReportWriter report_writer(bool plots) {
+  return [plots](const std::string& dir, const std::vector<SweepRecord>& records) {
+    write_sweep_report(dir, records, plots);
+  };
+}
+
 int merge(const SweepCliOptions& o) {
   if (!o.sweep.empty() || !o.report_dir.empty() || !o.shard.empty() || o.jobs)
     throw UsageError("--merge DIR... --out DIR combines shard directories; it takes no sweep file, --report, "
@@ -65,7 +71,7 @@ int merge(const SweepCliOptions& o) {
   if (o.out.empty()) throw UsageError("--merge needs --out DIR, the directory of the merged sweep");
   MergeOutcome r;
   try {
-    r = merge_sweeps(o.merge, o.out, o.restart, !o.no_plots);
+    r = merge_sweeps(o.merge, o.out, o.restart, report_writer(!o.no_plots));
   } catch (const SweepInputError& e) {
     throw UsageError(e.what());
   }
@@ -81,7 +87,7 @@ SweepOptions run_options(const SweepCliOptions& o, int jobs) {
   opts.out_dir = o.out.empty() ? (fs::path("out") / (fs::path(o.sweep).stem().string() + "-sweep")).string() : o.out;
   opts.jobs = jobs;
   opts.restart = o.restart;
-  opts.plots = !o.no_plots;
+  opts.write_report = report_writer(!o.no_plots);
   if (!o.shard.empty()) {
     try {
       opts.shard = parse_shard(o.shard);

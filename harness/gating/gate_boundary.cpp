@@ -11,7 +11,7 @@
 
 #include "io/scene_io.h"
 #include "sweep/sweep_search.h"
-#include "io/toml_text.h"
+#include "io/toml_reader.h"
 
 namespace tippe {
 
@@ -29,15 +29,7 @@ std::string g6(double v) {
 
 std::vector<BoundaryCheck> load_boundary_checks(const std::string& gate_path, const std::vector<std::string>& check_names) {
   std::vector<BoundaryCheck> out;
-  toml::table root;
-  try {
-    root = toml::parse(read_file_text(gate_path, kMaxInputFileBytes), gate_path);
-  } catch (const toml::parse_error& e) {
-    throw SceneError(gate_path + ":" + std::to_string(e.source().begin.line) + ":" +
-                     std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
-  } catch (const std::runtime_error& e) {
-    throw SceneError(e.what());
-  }
+  const toml::table root = read_toml_file(gate_path);
   const toml::node* bn = root.get("boundary");
   if (!bn) return out;
   const auto fail = [&](const std::string& key, const std::string& why) -> void {

@@ -1,8 +1,10 @@
 // Scene files: TOML -> Scene with every key checked, command-line overrides, and Scene -> JSON.
 #include "io/scene_io.h"
+#include "io/hash.h"
+#include "io/text.h"
 
 #include "registry.h"
-#include "io/toml_text.h"
+#include "io/toml_reader.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -41,32 +43,17 @@ constexpr double kMinRtol = 1e-15;
 // Looser than 1 % the reference is no longer a reference.
 constexpr double kMaxRtol = 1e-2;
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(12);
-  os << v;
-  return os.str();
-}
 
-std::string join_path(const std::string& prefix, const std::string& key) {
-  return prefix.empty() ? key : prefix + "." + key;
-}
 
 std::string fnv1a64_hex(const std::string& bytes, const std::vector<std::string>& overrides) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  auto feed = [&h](unsigned char c) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
-  };
-  for (unsigned char c : bytes) feed(c);
+  Fnv1a64 h;
+  h.add(bytes);
   // A separator keeps {"a", "bc"} and {"ab", "c"} apart.
   for (const auto& o : overrides) {
-    feed(0);
-    for (unsigned char c : o) feed(c);
+    h.add(static_cast<unsigned char>(0));
+    h.add(o);
   }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
+  return h.hex();
 }
 
 bool is_bare_key(const std::string& s) {
@@ -108,27 +95,11 @@ bool is_utf8(const std::string& s) {
   return true;
 }
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return {};
-  const auto e = s.find_last_not_of(" \t");
-  return s.substr(b, e - b + 1);
-}
 
 // Interprets a parsed scene document; every error names the file and the dotted key.
-class Interpreter {
+class Interpreter : public TomlReader {
  public:
-  Interpreter(std::string file, std::set<std::string> overridden)
-      : file_(std::move(file)), overridden_(std::move(overridden)) {}
-
-  [[noreturn]] void fail(const std::string& key, const std::string& why) const {
-    throw SceneError(file_ + ": " + key + ": " + why);
-  }
-
-  // The one form of every range error: "KEY: VALUE is out of range (expected RANGE)".
-  [[noreturn]] void out_of_range(const std::string& key, double v, const std::string& expected) const {
-    fail(key, num(v) + " is out of range (expected " + expected + ")");
-  }
+  Interpreter(std::string file, std::set<std::string> overridden) : TomlReader(std::move(file), std::move(overridden)) {}
 
   void apply_override(toml::table& root, const std::string& text) const {
     const auto eq = text.find('=');
@@ -194,85 +165,6 @@ class Interpreter {
   }
 
  private:
-  void keys(const toml::table& t, const std::string& prefix, std::initializer_list<const char*> allowed) const {
-    for (auto&& [k, v] : t) {
-      (void)v;
-      const std::string key(k.str());
-      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
-        std::string list;
-        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-        const std::string path = join_path(prefix, key);
-        fail(path, "unknown key (expected one of: " + list + ")" +
-                       (overridden_.count(path) ? "; it was set with --set" : ""));
-      }
-    }
-  }
-
-  const toml::table& need_table(const toml::table& t, const std::string& prefix, const char* key) const {
-    const toml::node* n = t.get(key);
-    if (!n) fail(join_path(prefix, key), "missing (required table)");
-    const toml::table* tbl = n->as_table();
-    if (!tbl) fail(join_path(prefix, key), "expected a table, got " + toml_value_text(*n));
-    return *tbl;
-  }
-
-  double to_number(const toml::node& n, const std::string& path) const {
-    double v;
-    if (const auto* f = n.as_floating_point()) v = f->get();
-    else if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
-    else fail(path, "expected a number, got " + toml_value_text(n));
-    if (!std::isfinite(v)) fail(path, "must be a finite number, got " + num(v));
-    return v;
-  }
-
-  std::optional<double> opt_number(const toml::table& t, const std::string& prefix, const char* key) const {
-    const toml::node* n = t.get(key);
-    if (!n) return std::nullopt;
-    return to_number(*n, join_path(prefix, key));
-  }
-
-  double need_number(const toml::table& t, const std::string& prefix, const char* key) const {
-    auto v = opt_number(t, prefix, key);
-    if (!v) fail(join_path(prefix, key), "missing (required)");
-    return *v;
-  }
-
-  double need_positive(const toml::table& t, const std::string& prefix, const char* key) const {
-    const double v = need_number(t, prefix, key);
-    if (!(v > 0)) out_of_range(join_path(prefix, key), v, std::string(key) + " > 0");
-    return v;
-  }
-
-  std::optional<bool> opt_bool(const toml::table& t, const std::string& prefix, const char* key) const {
-    const toml::node* n = t.get(key);
-    if (!n) return std::nullopt;
-    const auto* b = n->as_boolean();
-    if (!b) fail(join_path(prefix, key), "expected true or false, got " + toml_value_text(*n));
-    return b->get();
-  }
-
-  std::optional<std::string> opt_string(const toml::table& t, const std::string& prefix, const char* key) const {
-    const toml::node* n = t.get(key);
-    if (!n) return std::nullopt;
-    const auto* s = n->as_string();
-    if (!s) fail(join_path(prefix, key), "expected a string, got " + toml_value_text(*n));
-    return s->get();
-  }
-
-  std::optional<std::vector<double>> opt_numbers(const toml::table& t, const std::string& prefix, const char* key,
-                                                  size_t count) const {
-    const toml::node* n = t.get(key);
-    if (!n) return std::nullopt;
-    const std::string path = join_path(prefix, key);
-    const auto* a = n->as_array();
-    if (!a || a->size() != count)
-      fail(path, "expected an array of " + std::to_string(count) + " numbers, got " +
-                     (a ? "an array of " + std::to_string(a->size()) : toml_value_text(*n)));
-    std::vector<double> out;
-    for (size_t i = 0; i < a->size(); ++i) out.push_back(to_number(*a->get(i), path + "[" + std::to_string(i) + "]"));
-    return out;
-  }
-
   // A coefficient that belongs to another friction law: harmless only when it is 0.
   void must_be_zero_if_present(const toml::table& t, const char* key, const char* law) const {
     if (auto v = opt_number(t, "contact", key); v && *v != 0.0)
@@ -401,7 +293,7 @@ class Interpreter {
                                                     "inertia_axial"};
     const auto colon = what.find(": ");
     const bool keyed = colon != std::string::npos && body_keys.count(what.substr(0, colon));
-    return file_ + ": body" + (keyed ? "." : ": ") + what;
+    return file() + ": body" + (keyed ? "." : ": ") + what;
   }
 
   // One line each: a note is printed as a line of `tippe run` and a list item of a report.
@@ -498,11 +390,11 @@ class Interpreter {
   SettingValue to_setting(const toml::node& n, const std::string& path) const {
     if (const auto* b = n.as_boolean()) return b->get();
     if (const auto* i = n.as_integer()) return static_cast<long long>(i->get());
-    if (n.is_floating_point()) return to_number(n, path);
+    if (n.is_floating_point()) return number(n, path);
     if (const auto* s = n.as_string()) return s->get();
     if (const auto* a = n.as_array()) {
       std::vector<double> out;
-      for (size_t i = 0; i < a->size(); ++i) out.push_back(to_number(*a->get(i), path + "[" + std::to_string(i) + "]"));
+      for (size_t i = 0; i < a->size(); ++i) out.push_back(number(*a->get(i), path + "[" + std::to_string(i) + "]"));
       return out;
     }
     fail(path, "unsupported value (" + toml_value_text(n) +
@@ -524,7 +416,7 @@ class Interpreter {
       validate_engine_settings(s);
       if (reference_engine().adopt) reference_engine().adopt(s);
     } catch (const std::invalid_argument& e) {
-      throw SceneError(file_ + ": " + e.what());
+      throw SceneError(file() + ": " + e.what());
     }
   }
 
@@ -540,7 +432,7 @@ class Interpreter {
     if (!path) fail("engines.mujoco.model", "expected a string (a path to an MJCF file, relative to the scene file)");
     if (path->empty()) fail("engines.mujoco.model", "is empty (expected a path to an MJCF file)");
     std::filesystem::path p(*path);
-    if (p.is_relative()) p = std::filesystem::path(file_).parent_path() / p;
+    if (p.is_relative()) p = std::filesystem::path(file()).parent_path() / p;
     std::error_code ec;
     if (std::filesystem::is_directory(p, ec)) fail("engines.mujoco.model", p.string() + ": is a directory");
     try {
@@ -557,8 +449,6 @@ class Interpreter {
   const std::string& model_bytes() const { return model_bytes_; }
 
  private:
-  std::string file_;
-  std::set<std::string> overridden_;
   mutable std::string model_bytes_;
   mutable bool has_model_ = false;
 };
@@ -606,13 +496,7 @@ Scene parse_scene_text(const std::string& text, const std::string& file_label,
                        const std::vector<std::string>& overrides) {
   // The label is the scene's source_file in every JSON record: checked before any work is done.
   if (!is_utf8(file_label)) throw SceneError(file_label + ": cannot read: the path is not valid UTF-8");
-  toml::table root;
-  try {
-    root = toml::parse(text, file_label);
-  } catch (const toml::parse_error& e) {
-    throw SceneError(file_label + ":" + std::to_string(e.source().begin.line) + ":" +
-                     std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
-  }
+  toml::table root = parse_toml(text, file_label);
 
   std::set<std::string> overridden;
   for (const auto& o : overrides) overridden.insert(trim(o.substr(0, o.find('='))));

@@ -1,5 +1,6 @@
 // Run records: running a scene on one simulator, its summary numbers, JSON and CSV writers, atomic files.
 #include "records/records.h"
+#include "io/json_fields.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -34,19 +35,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Floor of the relative-drift denominator: J = 0 exactly (no spin) must not divide by zero.
 constexpr double kTinyJ = 1e-300;
 
-json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-json number(const std::optional<double>& v) { return v ? number(*v) : json(nullptr); }
 
-double get_number(const json& j, const char* key) {
-  const json& v = j.at(key);
-  return v.is_null() ? kNaN : v.get<double>();
-}
-
-std::optional<double> get_optional(const json& j, const char* key) {
-  const json& v = j.at(key);
-  if (v.is_null()) return std::nullopt;
-  return v.get<double>();
-}
 
 std::string errno_text() { return std::strerror(errno); }
 
@@ -293,59 +282,6 @@ RunRecord from_json(const json& j) {
   r.notes = j.at("notes").get<std::vector<std::string>>();
   r.provenance = provenance_from_json(j.at("provenance"));
   return r;
-}
-
-void write_file_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = temp_name(path);
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw OutputError(path + ": cannot write: " + errno_text());
-  auto fail = [&](const char* what) {
-    const std::string why = errno_text();
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    throw OutputError(path + ": " + what + ": " + why);
-  };
-  const char* p = text.data();
-  size_t left = text.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd, p, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      fail("cannot write");
-    }
-    p += n;
-    left -= static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) fail("cannot sync");
-  if (::close(fd) != 0) {
-    const std::string why = errno_text();
-    ::unlink(tmp.c_str());
-    throw OutputError(path + ": cannot close: " + why);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = errno_text();
-    ::unlink(tmp.c_str());
-    throw OutputError(path + ": cannot rename " + tmp + ": " + why);
-  }
-}
-
-std::string read_file_text(const std::string& path, size_t max_bytes) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": cannot read: is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot read: " + errno_text());
-  // Chunks up to one byte past the bound, so that an endless file (/dev/zero) stops there.
-  std::string text;
-  char buf[1 << 16];
-  while (in) {
-    in.read(buf, static_cast<std::streamsize>(std::min(sizeof buf, max_bytes + 1 - text.size())));
-    text.append(buf, static_cast<size_t>(in.gcount()));
-    if (text.size() > max_bytes)
-      throw std::runtime_error(path + ": cannot read: larger than " + std::to_string(max_bytes) +
-                               " bytes (the bound for this kind of file)");
-  }
-  if (in.bad()) throw std::runtime_error(path + ": cannot read: " + errno_text());
-  return text;
 }
 
 const std::vector<std::string>& trajectory_columns() {

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/files.h"
 #include "scene.h"
 #include "simulator.h"
 
@@ -112,28 +113,6 @@ RunRecord from_json(const nlohmann::json& j);
 // range of long long. Throws nlohmann::json::exception for a missing field or any other value;
 // json::get<long long> would convert a float such as 1e300 with undefined behaviour.
 long long json_integer(const nlohmann::json& j, const char* key);
-
-// An output that cannot be written (a path that cannot be created, a full disk, a file that
-// cannot be renamed into place): exit 2, like bad input. The message names the path and the reason.
-class OutputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// Size bounds of the files tippe reads. Input files (scenes, sweeps, gates): the largest shipped
-// one is under 10 KB, so 1 MiB is a hundred times any real one. Records and reference files
-// (records.jsonl, summary.json, comparison.json): a record line is ~3 KB and a plan has at most
-// kMaxSweepPoints (sweep.h) = 1e5 points, ~300 MB; 1 GiB leaves room and still fits in memory.
-constexpr size_t kMaxInputFileBytes = size_t{1} << 20;
-constexpr size_t kMaxRecordFileBytes = size_t{1} << 30;
-
-// Writes `text` to `path.tmp.PID`, fsyncs it and renames it over `path`, so readers see the old
-// file or the new one, never a part. Throws OutputError (temporary removed) on failure.
-void write_file_atomic(const std::string& path, const std::string& text);
-// A whole file's bytes, at most max_bytes of them; throws std::runtime_error "PATH: cannot read:
-// reason" (a directory included, and a file longer than max_bytes: /dev/zero or a FIFO ends
-// there instead of filling the memory). The file readers turn it into their own error type.
-std::string read_file_text(const std::string& path, size_t max_bytes = kMaxRecordFileBytes);
 
 // The trajectory columns, in file order.
 const std::vector<std::string>& trajectory_columns();

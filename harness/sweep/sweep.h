@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "io/hash.h"
 #include "measure/compare.h"
 #include "scene.h"
 #include "measure/task_farm.h"
@@ -79,6 +80,10 @@ struct SweepSetup {
   size_t point_count() const { return ladder_values.size() * (has_grid() ? grid_values.size() : 1); }
 };
 
+// A judgement: repeats only sharpen the minimum CPU time of a point, which settles after a few;
+// more than 100 is likelier a typo than a wish for a sweep that many times as long.
+constexpr int kMaxRepeats = 100;
+
 struct SweepSpec {
   std::string file;  // as given
   std::string hash;  // FNV-1a 64 of the file's bytes (16 hex digits)
@@ -137,8 +142,6 @@ struct SweepPlan {
 //    (setup[i].ladder.values[j] or setup[i].grid.values[j]).
 SweepPlan load_sweep(const std::string& path);
 
-// FNV-1a 64 of the parts, each followed by a 0 byte, as 16 hex digits.
-std::string fnv1a_hex(const std::vector<std::string>& parts);
 // Stable id of a point: hash of the scene's physics, the setup (name, engine, overrides, key),
 // the ladder value's text and the repeats; with a grid, then its key and the grid value's text
 // (a one-axis point's id is what it was before grids existed: published directories resume).
@@ -273,14 +276,18 @@ SweepShard parse_shard(const std::string& text);
 // balance their a priori cost (longest processing time first); a pure function of the plan.
 std::vector<size_t> shard_points(const SweepPlan& plan, const SweepShard& shard);
 
+using SweepReportWriter = std::function<void(const std::string& dir, const std::vector<SweepRecord>& records)>;
+
 struct SweepOptions {
   std::string out_dir;
   std::optional<SweepShard> shard;  // only this share of the points (sweep.json records which)
   int jobs = 1;
   bool restart = false;  // a DIR started with another sweep file (or other scene physics) is begun again
   bool progress = true;  // progress line with the time left on stderr
-  bool plots = true;     // gnuplot SVGs in the report
-  bool report = true;    // false: records only (a boundary search's waves write the report once, at the end)
+  // Writes the report into a staging directory from the finished records (the command line gives
+  // write_sweep_report); empty: records only (a boundary search's waves report once, at the end).
+  // The sweep itself knows nothing of reports: running and reporting meet in the command line.
+  SweepReportWriter write_report;
 };
 
 
@@ -317,7 +324,7 @@ struct MergeOutcome {
   std::vector<std::string> warnings;
 };
 MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std::string& out_dir, bool restart,
-                          bool plots);
+                          const SweepReportWriter& write_report);
 
 // ---- analysis (pure functions of records) -----------------------------------------------------
 

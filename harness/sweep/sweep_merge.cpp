@@ -77,7 +77,7 @@ bool same_dir(const fs::path& a, const fs::path& b) {
 }  // namespace
 
 MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std::string& out_dir, bool restart,
-                          bool plots) {
+                          const SweepReportWriter& write_report) {
   if (shard_dirs.empty()) refuse("--merge needs the shard directories");
   if (out_dir.empty()) refuse("--merge needs --out DIR for the merged sweep");
   const fs::path out = out_dir;
@@ -220,7 +220,7 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
     records.push_back(*r);
   }
   write_file_atomic(staged_records.string(), text);
-  write_sweep_report(stage.string(), records, plots);
+  if (write_report) write_report(stage.string(), records);
   lock.commit();
   outcome.shards = shards.size();
   outcome.points = records.size();

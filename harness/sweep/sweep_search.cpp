@@ -1,5 +1,6 @@
 // Boundary searches in sweeps: `ladder.search` read from a sweep file, the bisection replayed from records, the plan's waves, and the boundaries found.
 #include "sweep/sweep_search.h"
+#include "io/text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/scene_io.h"
-#include "io/toml_text.h"
+#include "io/toml_reader.h"
 
 namespace tippe {
 
@@ -22,14 +23,9 @@ namespace {
 
 using json = nlohmann::json;
 
-std::string num(double v) { return json(v).dump(); }
+// The shortest text that reads back as v.
+std::string shortest(double v) { return json(v).dump(); }
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return {};
-  const auto e = s.find_last_not_of(" \t");
-  return s.substr(b, e - b + 1);
-}
 
 }  // namespace
 
@@ -62,7 +58,7 @@ SweepSearch read_search(const toml::node& node, const std::string& file, const s
       v = static_cast<double>(i->get());
     else
       fail(k, "expected a number, got " + toml_value_text(*n));
-    if (!std::isfinite(v)) fail(k, "must be a finite number, got " + num(v));
+    if (!std::isfinite(v)) fail(k, "must be a finite number, got " + shortest(v));
     return v;
   };
   const auto string = [&](const char* name) {
@@ -78,10 +74,10 @@ SweepSearch read_search(const toml::node& node, const std::string& file, const s
   s.from = number("from", true, 0);
   s.to = number("to", true, 0);
   s.integer = t->get("from")->is_integer() && t->get("to")->is_integer();
-  if (!(s.from > 0)) fail(where + ".from", num(s.from) + " is out of range (expected from > 0: the search is in log10)");
-  if (!(s.to > s.from)) fail(where + ".to", num(s.to) + " is out of range (expected to > from = " + num(s.from) + ")");
+  if (!(s.from > 0)) fail(where + ".from", shortest(s.from) + " is out of range (expected from > 0: the search is in log10)");
+  if (!(s.to > s.from)) fail(where + ".to", shortest(s.to) + " is out of range (expected to > from = " + shortest(s.from) + ")");
   if (std::log10(s.to / s.from) > kMaxSearchDecades)
-    fail(where + ".to", num(s.to) + " is more than " + num(kMaxSearchDecades) + " decades above from = " + num(s.from));
+    fail(where + ".to", shortest(s.to) + " is more than " + shortest(kMaxSearchDecades) + " decades above from = " + shortest(s.from));
   s.criterion = string("criterion");
   try {
     parse_criterion(s.criterion);
@@ -90,8 +86,8 @@ SweepSearch read_search(const toml::node& node, const std::string& file, const s
   }
   s.resolution = number("resolution", false, s.resolution);
   if (!(s.resolution >= kMinSearchResolution && s.resolution <= kMaxSearchResolution))
-    fail(where + ".resolution", num(s.resolution) + " is out of range (expected " + num(kMinSearchResolution) +
-                                    " <= resolution <= " + num(kMaxSearchResolution) + ", in log10 units)");
+    fail(where + ".resolution", shortest(s.resolution) + " is out of range (expected " + shortest(kMinSearchResolution) +
+                                    " <= resolution <= " + shortest(kMaxSearchResolution) + ", in log10 units)");
   if (const toml::node* n = t->get("per_decade")) {
     const auto* i = n->as_integer();
     const std::string range = "1 <= per_decade <= " + std::to_string(kMaxSearchPerDecade);

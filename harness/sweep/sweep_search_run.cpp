@@ -48,7 +48,7 @@ SweepOutcome run_search_sweep(SweepPlan plan, const SweepOptions& o, TaskFarm& f
     if (!first && points.empty()) break;
     SweepOptions w = o;
     w.restart = first && o.restart;
-    w.report = false;
+    w.write_report = nullptr;
     // The first wave (the planned points, and any a resumed search replayed) has the progress
     // line; a bisection wave is a point per open bracket, announced in one line.
     if (!first) {

@@ -1,0 +1,177 @@
+// The one checked TOML reader: parsing with line and column in syntax errors, and the typed field checks.
+#include "io/toml_reader.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "io/scene_io.h"
+#include "io/text.h"
+#include "records/records.h"
+
+namespace tippe {
+
+const char* toml_type_name(toml::node_type t) {
+  switch (t) {
+    case toml::node_type::none: return "nothing";
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+  }
+  return "?";
+}
+
+std::string toml_value_text(const toml::node& n) {
+  std::string out = toml_type_name(n.type());
+  if (n.is_table() || n.is_array()) return out;
+  std::ostringstream os;
+  n.visit([&os](const auto& v) { os << v; });
+  std::string text = os.str();
+  if (text.size() > 40) {
+    size_t cut = 37;
+    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+    text = text.substr(0, cut) + "...";
+  }
+  return out + " " + text;
+}
+
+toml::table parse_toml(const std::string& text, const std::string& file) {
+  try {
+    return toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    throw SceneError(file + ":" + std::to_string(e.source().begin.line) + ":" +
+                     std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
+  }
+}
+
+toml::table read_toml_file(const std::string& file, std::string* text) {
+  std::string bytes;
+  try {
+    bytes = read_file_text(file, kMaxInputFileBytes);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
+  }
+  toml::table root = parse_toml(bytes, file);
+  if (text) *text = std::move(bytes);
+  return root;
+}
+
+void TomlReader::fail(const std::string& key, const std::string& why) const {
+  throw SceneError(file_ + ": " + key + ": " + why);
+}
+
+void TomlReader::out_of_range(const std::string& key, double v, const std::string& expected) const {
+  out_of_range(key, num(v), expected);
+}
+
+void TomlReader::out_of_range(const std::string& key, const std::string& value, const std::string& expected) const {
+  fail(key, value + " is out of range (expected " + expected + ")");
+}
+
+void TomlReader::keys(const toml::table& t, const std::string& prefix, const std::vector<std::string>& allowed) const {
+  for (auto&& [k, v] : t) {
+    (void)v;
+    const std::string key(k.str());
+    bool known = false;
+    for (const auto& a : allowed) known = known || key == a;
+    if (known) continue;
+    const std::string path = join_path(prefix, key);
+    fail(path, "unknown key (expected one of: " + join(allowed, ", ") + ")" +
+                   (overridden(path) ? "; it was set with --set" : ""));
+  }
+}
+
+double TomlReader::number(const toml::node& n, const std::string& key) const {
+  double v = 0;
+  if (const auto* f = n.as_floating_point())
+    v = f->get();
+  else if (const auto* i = n.as_integer())
+    v = static_cast<double>(i->get());
+  else
+    fail(key, "expected a number, got " + toml_value_text(n));
+  if (!std::isfinite(v)) fail(key, "must be a finite number, got " + num(v));
+  return v;
+}
+
+std::string TomlReader::string(const toml::node& n, const std::string& key) const {
+  const auto* s = n.as_string();
+  if (!s) fail(key, "expected a string, got " + toml_value_text(n));
+  return s->get();
+}
+
+bool TomlReader::boolean(const toml::node& n, const std::string& key) const {
+  const auto* b = n.as_boolean();
+  if (!b) fail(key, "expected true or false, got " + toml_value_text(n));
+  return b->get();
+}
+
+const toml::array& TomlReader::array(const toml::node& n, const std::string& key) const {
+  const auto* a = n.as_array();
+  if (!a) fail(key, "expected an array, got " + toml_value_text(n));
+  return *a;
+}
+
+const toml::table& TomlReader::table(const toml::node& n, const std::string& key) const {
+  const auto* t = n.as_table();
+  if (!t) fail(key, "expected a table, got " + toml_value_text(n));
+  return *t;
+}
+
+const toml::table& TomlReader::need_table(const toml::table& t, const std::string& prefix, const char* key) const {
+  const toml::node* n = t.get(key);
+  if (!n) fail(join_path(prefix, key), "missing (required table)");
+  return table(*n, join_path(prefix, key));
+}
+
+std::optional<double> TomlReader::opt_number(const toml::table& t, const std::string& prefix, const char* key) const {
+  const toml::node* n = t.get(key);
+  if (!n) return std::nullopt;
+  return number(*n, join_path(prefix, key));
+}
+
+double TomlReader::need_number(const toml::table& t, const std::string& prefix, const char* key) const {
+  auto v = opt_number(t, prefix, key);
+  if (!v) fail(join_path(prefix, key), "missing (required)");
+  return *v;
+}
+
+double TomlReader::need_positive(const toml::table& t, const std::string& prefix, const char* key) const {
+  const double v = need_number(t, prefix, key);
+  if (!(v > 0)) out_of_range(join_path(prefix, key), v, std::string(key) + " > 0");
+  return v;
+}
+
+std::optional<bool> TomlReader::opt_bool(const toml::table& t, const std::string& prefix, const char* key) const {
+  const toml::node* n = t.get(key);
+  if (!n) return std::nullopt;
+  return boolean(*n, join_path(prefix, key));
+}
+
+std::optional<std::string> TomlReader::opt_string(const toml::table& t, const std::string& prefix,
+                                                  const char* key) const {
+  const toml::node* n = t.get(key);
+  if (!n) return std::nullopt;
+  return string(*n, join_path(prefix, key));
+}
+
+std::optional<std::vector<double>> TomlReader::opt_numbers(const toml::table& t, const std::string& prefix,
+                                                           const char* key, size_t count) const {
+  const toml::node* n = t.get(key);
+  if (!n) return std::nullopt;
+  const std::string path = join_path(prefix, key);
+  const auto* a = n->as_array();
+  if (!a || a->size() != count)
+    fail(path, "expected an array of " + std::to_string(count) + " numbers, got " +
+                   (a ? "an array of " + std::to_string(a->size()) : toml_value_text(*n)));
+  std::vector<double> out;
+  for (size_t i = 0; i < a->size(); ++i) out.push_back(number(*a->get(i), idx(path, i)));
+  return out;
+}
+
+}  // namespace tippe

@@ -1,0 +1,181 @@
+// The metrics of one engine's run against the reference, a pure function of two trajectories and their records.
+#include "measure/metrics.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include "io/json_fields.h"
+
+namespace tippe {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Accumulates |difference| over the common grid.
+struct ErrorStats {
+  double sum_sq = 0, max = 0;
+  long long n = 0;
+  void add(double e) {
+    if (!std::isfinite(e)) return;
+    sum_sq += e * e;
+    max = std::max(max, std::abs(e));
+    ++n;
+  }
+  double rms() const { return n ? std::sqrt(sum_sq / static_cast<double>(n)) : kNaN; }
+  double maximum() const { return n ? max : kNaN; }
+};
+
+// Every per-sample column but t and surface, for code that treats them alike.
+template <class T>
+auto sampled_columns(T& tr) {
+  return std::array{&tr.theta, &tr.energy,  &tr.jellett, &tr.normal_force, &tr.slip_speed,
+                    &tr.contact_latitude, &tr.x_C, &tr.y_C, &tr.x_G, &tr.y_G};
+}
+
+// The engine's columns on the reference's times ref.t[offset + k], as far as both runs go.
+Trajectory engine_on_reference_grid(const Trajectory& ref, const Trajectory& eng, double dt, size_t& offset) {
+  offset = 0;
+  const size_t n = std::min(ref.size(), eng.size());
+  bool aligned = true;
+  for (size_t k = 0; k < n && aligned; ++k) aligned = std::abs(ref.t[k] - eng.t[k]) <= 0.5 * dt;
+  Trajectory out;
+  const auto from = sampled_columns(eng);
+  const auto to = sampled_columns(out);
+  if (aligned) {
+    out.t.assign(ref.t.begin(), ref.t.begin() + static_cast<std::ptrdiff_t>(n));
+    out.surface.assign(eng.surface.begin(), eng.surface.begin() + static_cast<std::ptrdiff_t>(n));
+    for (size_t c = 0; c < from.size(); ++c)
+      to[c]->assign(from[c]->begin(), from[c]->begin() + static_cast<std::ptrdiff_t>(n));
+    return out;
+  }
+  // Different grids (an engine that stopped between grid points, or a run sampled differently):
+  // linear interpolation between the engine's samples that bracket each reference time.
+  if (eng.size() == 0) return out;
+  size_t j = 0;
+  for (size_t k = 0; k < ref.size(); ++k) {
+    const double t = ref.t[k];
+    if (t < eng.t.front() - 1e-12 * std::max(1.0, std::abs(t))) {
+      offset = k + 1;
+      continue;
+    }
+    if (t > eng.t.back() + 1e-12 * std::max(1.0, std::abs(t))) break;
+    while (j + 1 < eng.size() && eng.t[j + 1] < t) ++j;
+    const size_t j1 = std::min(j + 1, eng.size() - 1);
+    const double span = eng.t[j1] - eng.t[j];
+    const double w = span > 0 ? std::clamp((t - eng.t[j]) / span, 0.0, 1.0) : 0.0;
+    out.t.push_back(t);
+    out.surface.push_back(w < 0.5 ? eng.surface[j] : eng.surface[j1]);
+    for (size_t c = 0; c < from.size(); ++c) to[c]->push_back((1 - w) * (*from[c])[j] + w * (*from[c])[j1]);
+  }
+  return out;
+}
+
+void compare_event(const std::optional<double>& t_ref, const std::optional<double>& t_eng, std::string& which,
+                   std::optional<double>& abs_error, std::optional<double>& rel_error) {
+  which = t_ref && t_eng ? "both" : t_eng ? "engine_only" : t_ref ? "reference_only" : "neither";
+  if (!(t_ref && t_eng)) return;
+  abs_error = *t_eng - *t_ref;
+  if (*t_ref != 0.0) rel_error = *abs_error / *t_ref;
+}
+
+}  // namespace
+
+// ---- metrics --------------------------------------------------------------------------------
+
+bool energy_must_not_rise(const Scene& scene) {
+  const ContactSpec& c = scene.contact;
+  if (c.friction == FrictionLaw::None) return false;
+  if (c.drilling > 0) return true;
+  // A law whose coefficient is zero removes nothing: rises there are noise, not injected energy.
+  return (c.friction == FrictionLaw::Viscous && c.k > 0) || (c.friction == FrictionLaw::Coulomb && c.mu > 0) ||
+         (c.friction == FrictionLaw::Gliding && c.mu > 0);
+}
+
+Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, const RunRecord& engine,
+                     const Trajectory& engine_traj, const Scene& scene, std::optional<double> converged_until) {
+  Metrics m;
+  m.reference_converged_until = converged_until;
+  // Inside the window: the reference's event when it has one, else the engine's (a converged
+  // reference could have the event later); an event neither has is not known past the window.
+  auto judged = [&](const std::optional<double>& t_ref, const std::optional<double>& t_eng) {
+    if (!converged_until) return true;
+    if (t_ref) return *t_ref <= *converged_until;
+    return t_eng && *t_eng <= *converged_until;
+  };
+  if (judged(reference.inversion_time, engine.inversion_time))
+    compare_event(reference.inversion_time, engine.inversion_time, m.inversion_event, m.inversion_time_abs_error,
+                  m.inversion_time_rel_error);
+  else
+    m.inversion_event = "unconverged";
+  if (judged(reference.stem_contact_time, engine.stem_contact_time))
+    compare_event(reference.stem_contact_time, engine.stem_contact_time, m.stem_contact_event,
+                  m.stem_contact_time_abs_error, m.stem_contact_time_rel_error);
+  else
+    m.stem_contact_event = "unconverged";
+
+  const double R = scene.body.sphere_radius;
+  const double E0_ref = ref_traj.size() ? ref_traj.energy.front() : reference.energy_initial;
+  // Guards against a scene whose energy origin makes E0 = 0: errors are then absolute.
+  const double e_scale = std::isfinite(E0_ref) && E0_ref != 0.0 ? std::abs(E0_ref) : 1.0;
+
+  size_t offset = 0;
+  const Trajectory eng = engine_on_reference_grid(ref_traj, engine_traj, scene.run.sample_interval, offset);
+  ErrorStats tilt, energy, contact, com, latitude;
+  size_t compared = 0;
+  for (size_t k = 0; k < eng.size(); ++k) {
+    const size_t r = offset + k;
+    if (converged_until && ref_traj.t[r] > *converged_until) break;
+    compared = k + 1;
+    tilt.add(eng.theta[k] - ref_traj.theta[r]);
+    energy.add((eng.energy[k] - ref_traj.energy[r]) / e_scale);
+    contact.add(std::hypot(eng.x_C[k] - ref_traj.x_C[r], eng.y_C[k] - ref_traj.y_C[r]) / R);
+    com.add(std::hypot(eng.x_G[k] - ref_traj.x_G[r], eng.y_G[k] - ref_traj.y_G[r]) / R);
+    latitude.add(eng.contact_latitude[k] - ref_traj.contact_latitude[r]);
+  }
+  m.tilt_max_error = tilt.maximum();
+  m.tilt_rms_error = tilt.rms();
+  m.energy_max_error = energy.maximum();
+  m.contact_path_rms_error = contact.rms();
+  m.contact_path_max_error = contact.maximum();
+  m.com_path_rms_error = com.rms();
+  m.com_path_max_error = com.maximum();
+  m.latitude_rms_error = latitude.rms();
+  m.compared_until = compared ? eng.t[compared - 1] : kNaN;
+
+  if (engine_traj.size()) {
+    const double E0 = engine_traj.energy.front();
+    m.energy_final_ratio = engine_traj.energy.back() / E0;
+    if (energy_must_not_rise(scene)) {
+      const double threshold = kEnergyGainTolerance * std::abs(E0);
+      for (size_t k = 1; k < engine_traj.size(); ++k) {
+        const double rise = engine_traj.energy[k] - engine_traj.energy[k - 1];
+        if (rise > threshold) {
+          ++m.energy_gain_events;
+          m.energy_max_gain = std::max(m.energy_max_gain, rise / std::abs(E0));
+        }
+      }
+    }
+  } else {
+    m.energy_final_ratio = kNaN;
+  }
+
+  m.jellett_drift_ball = engine.jellett_drift_ball;
+  m.jellett_drift_stem = engine.jellett_drift_stem;
+  m.jellett_max_relative_drift = engine.jellett_max_relative_drift;
+  m.wall_seconds = engine.work.wall_seconds;
+  m.cpu_seconds = engine.work.cpu_seconds;
+  m.steps = engine.work.steps;
+  m.real_time_factor = engine.work.wall_seconds > 0 && std::isfinite(engine.final_time)
+                           ? engine.final_time / engine.work.wall_seconds
+                           : 0.0;
+  const double ref_cpu = reference.work.cpu_seconds;
+  m.cost_ratio = ref_cpu > 0 && std::isfinite(engine.work.cpu_seconds) ? engine.work.cpu_seconds / ref_cpu : 0.0;
+  return m;
+}
+
+}  // namespace tippe

@@ -1,0 +1,53 @@
+// What the parts of a sweep run share: each scene's reference, one point's run, and a point's a-priori cost.
+#pragma once
+
+#include <cmath>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "measure/compare.h"
+#include "sweep/sweep.h"
+
+namespace tippe::sweep_detail {
+
+// The reference of one scene, shared read-only by every point of it.
+struct Reference {
+  RunRecord record;
+  Trajectory trajectory;
+  std::optional<SweepRecord::ReferenceRun> summary;  // filled once loaded or computed
+  // A reference that failed is a result: every point of its scene is recorded as failed with
+  // this reason (non-empty) instead of being run against nothing.
+  std::string failure;
+  double failure_time = std::nan("");
+};
+
+// A point whose scene's reference failed: a failed record carrying the reference's reason, so that
+// the other scenes' points run and the report shows which scene and why.
+SweepRecord reference_failed_record(SweepRecord r, const Scene& scene, const Reference& ref);
+SweepRecord::ReferenceRun reference_summary(const Scene& scene, const Reference& ref);
+
+// The reference's two cache files as texts, "summary.json" then "trajectory.csv", each behind its
+// length: what a worker sends back and what the coordinator shares with every rank.
+std::string pack_texts(const std::string& summary, const std::string& csv);
+// Reads one pack_texts pair at `pos` (advanced past it); throws std::runtime_error when cut short.
+std::pair<std::string, std::string> unpack_texts(const std::string& bytes, size_t& pos);
+// What a reference's task sends back: 'R' and its two cache files' texts, or 'F' and, for a
+// reference that failed, the time and the reason (a result, not an error: its scene's points are
+// recorded as failed).
+std::string failed_reference_text(double time, const std::string& why);
+// Reads a failed_reference_text at `pos` into ref; false (pos unmoved) for an 'R' entry.
+bool read_failed_reference(const std::string& bytes, size_t& pos, Reference& ref);
+// Runs the reference at the scene's own tolerances, on whichever process the task lands.
+std::string compute_reference_texts(const Scene& scene);
+// Into the cache dir and into memory, read back from the very texts every other rank will read.
+void store_reference(const std::filesystem::path& dir, const Scene& scene, const std::string& hash,
+                     const std::string& texts, Reference& ref);
+
+// Runs one point `repeats` times on the calling thread into its record.
+SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Reference& ref);
+// A priori cost of a point in arbitrary units (steps for a time-step ladder).
+double point_weight(const SweepPlan& plan, const SweepPoint& p);
+
+}  // namespace tippe::sweep_detail

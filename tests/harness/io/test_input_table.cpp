@@ -1,0 +1,529 @@
+// Tables of malformed inputs: scene files (and odd but valid ones), and out-of-range values across scene, sweep and gate files, each naming the file, key and value; and malformed record counts.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <functional>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "measure/compare.h"
+#include "gating/gate.h"
+#include "records/records.h"
+#include "io/scene_io.h"
+#include "sweep/sweep.h"
+#include "support/files.h"
+#include "support/process.h"
+#include "support/fixtures.h"
+
+namespace fs = std::filesystem;
+using namespace tippe;
+
+namespace {
+
+using namespace tippe::fixtures;
+
+
+std::string replace_all(std::string text, const std::string& from, const std::string& to) {
+  for (size_t pos = 0; (pos = text.find(from, pos)) != std::string::npos; pos += to.size()) text.replace(pos, from.size(), to);
+  return text;
+}
+
+struct Case {
+  const char* name;
+  std::string text;
+  std::vector<std::string> overrides;
+  // Empty: the input is valid and must load. Otherwise every fragment must appear in the
+  // message, which must start with the file's path.
+  std::vector<std::string> fragments;
+  std::string file_name = "";  // default: NAME.toml
+};
+
+std::vector<Case> cases() {
+  const std::string b = kBase;
+  const std::string coulomb = edit(b, "friction = \"viscous\"\nk = 1.0", "friction = \"coulomb\"\nmu = 0.3");
+  const std::string by_density =
+      edit(b, "mass = 1.0\ncom_offset = 0.3\ninertia_transverse = 0.4\ninertia_axial = 0.45\n", "density = 1.0\n");
+  const std::string long_key(5000, 'k');
+  std::string deep_arrays = "x = " + std::string(300, '[') + std::string(300, ']') + "\n";
+  std::string deep_tables = "[a";
+  for (int i = 0; i < 300; ++i) deep_tables += ".a";
+  deep_tables += "]\n";
+  std::string inline_body = "name = \"base\"\ngravity = 1\n"
+                            "body = { sphere_radius = 1.0, stem_radius = 0.25, stem_length = 1.2, truncation_height = 0.9, "
+                            "mass = 1.0, com_offset = 0.3, inertia_transverse = 0.4, inertia_axial = 0.45 }\n" +
+                            b.substr(b.find("[contact]"));
+  return {
+      // ---- bytes and TOML syntax: "FILE:LINE:COL: reason"
+      {"non_utf8_bytes", edit(b, "test scene", "caf\xe9 \xff"), {}, {":2:", "utf-8"}},
+      {"nul_byte", edit(b, "gravity = 1", std::string("gravity = 1\0", 12)), {}, {":3:", "expected digit"}},
+      {"control_character_in_string", edit(b, "test scene", "test\x01scene"), {}, {":2:", "control characters"}},
+      {"carriage_returns_only", replace_all(b, "\n", "\r"), {}, {":1:", "'\\r'"}},
+      {"float_overflow_1e400", edit(b, "spin = 5.0", "spin = 1e400"), {}, {":18:", "'1e400'"}},
+      {"integer_overflow", edit(b, "gravity = 1", "gravity = 99999999999999999999"), {}, {":3:", "not representable in 64 bits"}},
+      {"duplicate_key", edit(b, "tilt = 0.1", "tilt = 0.1\ntilt = 0.2"), {}, {":18:", "cannot redefine", "'tilt'"}},
+      {"duplicate_table", b + "[body]\nmass = 2.0\n", {}, {":25:", "cannot redefine existing table 'body'"}},
+      {"deeply_nested_arrays", deep_arrays + b, {}, {":1:", "maximum nested value depth"}},
+      // ---- structure: "FILE: KEY: reason"
+      {"empty_file", "", {}, {": gravity: missing (required)"}},
+      {"only_a_comment", "# a scene file with nothing in it\n", {}, {": gravity: missing (required)"}},
+      {"deeply_nested_tables", deep_tables + b, {}, {": a: unknown key"}},
+      {"array_of_tables_for_a_table", edit(b, "[contact]", "[[contact]]"), {}, {": contact: expected a table, got an array"}},
+      {"engines_not_a_table", "engines = 5\n" + b, {}, {": engines: expected a table of [engines.NAME] tables, got an integer"}},
+      {"very_long_key", edit(b, "[body]\n", "[body]\n" + long_key + " = 1\n"), {}, {": body." + long_key + ": unknown key"}},
+      {"string_where_array_expected", edit(b, "velocity = [0.0, 0.0]", "velocity = \"0, 0\""), {},
+       {": initial.velocity: expected an array of 2 numbers, got a string"}},
+      {"velocity_of_wrong_length", edit(b, "velocity = [0.0, 0.0]", "velocity = [0.0, 0.0, 0.0]"), {},
+       {": initial.velocity: expected an array of 2 numbers, got an array of 3"}},
+      {"array_inside_number_array", edit(b, "spin = 5.0", "omega = [[0.0], 0.0, 5.0]"), {},
+       {": initial.omega[0]: expected a number, got an array"}},
+      {"infinite_array_element", edit(b, "spin = 5.0", "omega = [0.0, 0.0, inf]"), {}, {": initial.omega[2]: must be a finite number"}},
+      {"date_where_number_expected", edit(b, "duration = 25.0", "duration = 1979-05-27"), {}, {": run.duration: expected a number, got a date"}},
+      {"name_not_a_string", edit(b, "name = \"base\"", "name = 5"), {}, {": name: expected a string, got an integer"}},
+      {"name_with_a_path", edit(b, "name = \"base\"", "name = \"../etc\""), {}, {": name: \"../etc\" is not a usable name"}},
+      {"file_stem_not_a_name", edit(b, "name = \"base\"\n", ""), {}, {": name: \"bad name\" (the file's stem) is not a usable name"},
+       "bad name.toml"},
+      {"multi_line_description", edit(b, "\"test scene\"", "\"\"\"two\nlines\"\"\""), {}, {": description: must be one line"}},
+      {"negative_gravity", edit(b, "gravity = 1", "gravity = -9.81"), {}, {": gravity: -9.81 is out of range (expected gravity > 0)"}},
+      {"friction_not_a_string", edit(b, "friction = \"viscous\"", "friction = 1"), {}, {": contact.friction: expected a string, got an integer"}},
+      {"stem_not_a_boolean", edit(b, "k = 1.0", "k = 1.0\nstem = \"yes\""), {}, {": contact.stem: expected true or false, got a string"}},
+      {"negative_k", edit(b, "k = 1.0", "k = -1.0"), {}, {": contact.k: -1 is out of range (expected k >= 0)"}},
+      {"drilling_without_friction", edit(b, "friction = \"viscous\"\nk = 1.0", "friction = \"none\"\ndrilling = 0.1"), {},
+       {": contact.drilling: does not apply to friction = \"none\""}},
+      {"mass_model_unknown", edit(by_density, "density = 1.0", "density = 1.0\nmass_model = \"hollow\""), {},
+       {": body.mass_model: unknown model \"hollow\""}},
+      {"mass_model_missing", by_density, {}, {": body.mass_model: missing (required with density"}},
+      {"omega_along_contact_not_a_boolean", edit(b, "spin = 5.0", "spin = 5.0\nomega_along_contact = 1"), {},
+       {": initial.omega_along_contact: expected true or false, got an integer"}},
+      {"omega_along_contact_with_omega", edit(b, "spin = 5.0", "omega = [0.0, 0.0, 5.0]\nomega_along_contact = true"), {},
+       {": initial.omega_along_contact: takes its magnitude from spin"}},
+      {"height_without_flight", edit(b, "tilt = 0.1", "tilt = 0.1\nheight = 0.5"), {},
+       {": initial.height: a start above the floor needs contact.flight = true"}},
+      {"negative_height", edit(b, "tilt = 0.1", "tilt = 0.1\nheight = -0.5"), {}, {": initial.height: -0.5 is out of range (expected height >= 0)"}},
+      {"orientation_and_tilt", edit(b, "tilt = 0.1", "tilt = 0.1\norientation = [1.0, 0.0, 0.0, 0.0]"), {},
+       {": initial.orientation: give either tilt or orientation, not both"}},
+      {"orientation_not_unit", edit(b, "tilt = 0.1", "orientation = [1.0, 0.1, 0.0, 0.0]"), {},
+       {": initial.orientation: must be a unit quaternion [w, x, y, z], got norm 1.00498756211"}},
+      {"orientation_of_wrong_length", edit(b, "tilt = 0.1", "orientation = [1.0, 0.0, 0.0]"), {},
+       {": initial.orientation: expected an array of 4 numbers, got an array of 3"}},
+      {"position_of_wrong_length", edit(b, "tilt = 0.1", "tilt = 0.1\nposition = [0.0]"), {},
+       {": initial.position: expected an array of 2 numbers, got an array of 1"}},
+      {"notes_not_strings", "notes = [1]\n" + b, {}, {": notes[0]: expected a string, got an integer"}},
+      {"note_of_two_lines", "notes = [\"a\\nb\"]\n" + b, {}, {": notes[0]: must be one non-empty line"}},
+      {"mujoco_model_missing", edit(b, "[run]", "[engines.mujoco]\nmodel = \"no_such_model.xml\"\n\n[run]"), {},
+       {": engines.mujoco.model: ", "no_such_model.xml: cannot read: No such file or directory"}},
+      {"method_unknown", edit(b, "atol = 1e-12", "atol = 1e-12\nmethod = \"euler\""), {},
+       {": run.method: must be \"bulirsch_stoer\", \"dopri5\" or \"rosenbrock4\", got \"euler\""}},
+      {"method_not_a_string", edit(b, "atol = 1e-12", "atol = 1e-12\nmethod = 4"), {}, {": run.method: expected a string"}},
+      {"atol_out_of_range", edit(b, "atol = 1e-12", "atol = 2"), {}, {": run.atol: 2 is out of range (expected 0 < atol <= 1)"}},
+      {"too_many_samples", edit(b, "sample_interval = 0.01", "sample_interval = 1e-12"), {},
+       {": run.sample_interval: 1e-12 gives 2.5e+13 samples, up to "}},
+      // 1e8 samples passed the old count guard: ~55 GB of CSV. The budget is bytes.
+      {"samples_over_the_byte_budget", edit(b, "sample_interval = 0.01", "sample_interval = 2.5e-7"), {},
+       {": run.sample_interval: 2.5e-07 gives 100000001 samples, up to 82398 MiB of trajectory, over the budget of 1024 MiB"}},
+      {"engine_array_with_a_string", b + "[engines.mujoco]\nsolref = [0.002, \"x\"]\n", {},
+       {": engines.mujoco.solref[1]: expected a number, got a string"}},
+      {"coulomb_negative_mu", edit(coulomb, "mu = 0.3", "mu = -0.3"), {}, {": contact.mu: -0.3 is out of range (expected mu >= 0)"}},
+      {"drilling_law_unknown", edit(coulomb, "mu = 0.3", "mu = 0.3\ndrilling = 0.01\ndrilling_law = \"elliptic\""), {},
+       {": contact.drilling_law: unknown law \"elliptic\" (expected decoupled or coupled)"}},
+      {"drilling_law_not_a_string", edit(coulomb, "mu = 0.3", "mu = 0.3\ndrilling = 0.01\ndrilling_law = 1"), {},
+       {": contact.drilling_law: expected a string, got an integer"}},
+      {"drilling_law_coupled_with_viscous", edit(b, "k = 1.0", "k = 1.0\ndrilling = 0.01\ndrilling_law = \"coupled\""), {},
+       {": contact.drilling_law: \"coupled\" needs friction = \"coulomb\"", "got friction = \"viscous\""}},
+      {"drilling_law_coupled_without_drilling", edit(coulomb, "mu = 0.3", "mu = 0.3\ndrilling_law = \"coupled\""), {},
+       {": contact.drilling_law: \"coupled\" needs contact.drilling > 0", "got 0"}},
+      {"drilling_law_coupled_without_mu", edit(coulomb, "mu = 0.3", "mu = 0\ndrilling = 0.01\ndrilling_law = \"coupled\""), {},
+       {": contact.drilling_law: \"coupled\" needs contact.mu > 0, got 0"}},
+      {"drilling_law_coupled_valid", edit(coulomb, "mu = 0.3", "mu = 0.3\ndrilling = 0.01\ndrilling_law = \"coupled\""), {}, {}},
+      // ---- --set overrides
+      {"set_only_equals", b, {"="}, {": --set: malformed override \"=\""}},
+      {"set_empty", b, {""}, {": --set: malformed override \"\""}},
+      {"set_key_ends_with_dot", b, {"contact.=1"}, {": --set: malformed key \"contact.\""}},
+      {"set_key_with_tab", b, {"contact.\tmu=1"}, {": --set: malformed key"}},
+      {"set_into_an_array", b, {"initial.velocity.x=1"}, {": --set: cannot set initial.velocity.x: initial.velocity is not a table"}},
+      {"set_into_a_string", b, {"name.x=1"}, {": --set: cannot set name.x: name is not a table"}},
+      {"set_value_overflows", b, {"run.duration=1e400"}, {": run.duration: expected a number, got a string"}},
+      {"set_replaces_a_table", b, {"body={}"}, {": body.sphere_radius: missing (required)"}},
+      {"set_newline_in_description", b, {"description=a\nb"}, {": description: must be one line"}},
+      // Found by reading the fuzzer's contract: both used to load, run the whole simulation and
+      // then fail writing the JSON record ("internal: [json.exception.type_error.316]").
+      {"set_value_not_utf8", b, {"description=caf\xe9"}, {": --set: the value of description is not valid UTF-8"}},
+      {"set_value_overlong_utf8", b, {"engines.ode.stepper=\xc0\xaf"}, {": --set: the value of engines.ode.stepper is not valid UTF-8"}},
+      {"set_value_utf16_surrogate", b, {"description=\xed\xa0\x80"}, {": --set: the value of description is not valid UTF-8"}},
+      {"path_not_utf8", b, {}, {": cannot read: the path is not valid UTF-8"}, "caf\xe9.toml"},
+      // ---- odd but valid: must load
+      {"negative_zero_tilt", edit(b, "tilt = 0.1", "tilt = -0.0"), {}, {}},
+      {"byte_order_mark", "\xef\xbb\xbf" + b, {}, {}},
+      {"crlf_line_ends", replace_all(b, "\n", "\r\n"), {}, {}},
+      {"inline_table_for_body", inline_body, {}, {}},
+      {"hex_integer_gravity", edit(b, "gravity = 1", "gravity = 0x10"), {}, {}},
+      {"set_unterminated_string_is_a_bare_word", b, {"description=\"abc"}, {}},
+      {"set_value_utf8_bare_word", b, {"description=caf\xc3\xa9 \xf0\x9f\x8c\x80"}, {}},
+  };
+}
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+class InputTable : public ::testing::TestWithParam<Case> {};
+
+TEST_P(InputTable, NamesFileAndKeyOrLoads) {
+  const Case& c = GetParam();
+  TempDir dir{"tippe-input"};
+  const std::string path = dir.write(c.file_name.empty() ? std::string(c.name) + ".toml" : c.file_name, c.text);
+  const std::string msg = error_of([&] { load_scene(path, c.overrides); });
+  // The in-memory parser (what the fuzzer drives) says exactly what load_scene says.
+  EXPECT_EQ(error_of([&] { parse_scene_text(c.text, path, c.overrides); }), msg);
+  if (c.fragments.empty()) {
+    EXPECT_EQ(msg, "") << "a valid input was rejected";
+    return;
+  }
+  ASSERT_NE(msg, "") << "a malformed input was accepted";
+  EXPECT_EQ(msg.rfind(path + ":", 0), 0u) << msg;
+  for (const auto& f : c.fragments) EXPECT_NE(msg.find(f), std::string::npos) << "want \"" << f << "\" in: " << msg;
+}
+
+INSTANTIATE_TEST_SUITE_P(Inputs, InputTable, ::testing::ValuesIn(cases()),
+                         [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+
+// ---- out-of-range values, wrong types and non-finite numbers in all three file kinds ----------
+
+// A valid sweep and a valid gate file over kBase (written as scenes/base.toml); every case below
+// is one edit of one of them (or of kBase), so that its message is about that edit alone.
+const char* const kSweepBase = R"(description = "input table sweep"
+repeats = 1
+duration = 0.5
+scenes = ["../scenes/base.toml"]
+
+[[setup]]
+name = "ode"
+engine = "ode"
+set = ["engines.ode.iterations=20"]
+ladder.key = "engines.ode.timestep"
+ladder.values = [1e-3, 5e-4]
+
+[[setup]]
+name = "reference"
+engine = "analytic"
+ladder.key = "run.rtol"
+ladder.values = [1e-6, 1e-8]
+)";
+
+const char* const kGateBase = R"([defaults]
+scene = "../scenes/base.toml"
+duration = 0.5
+
+[[check]]
+name = "ode-default"
+engine = "ode"
+set = ["engines.ode.timestep=1e-3"]
+[check.max]
+tilt_rms_error = 0.05
+steps = 1000
+)";
+
+enum class Kind { Scene, Sweep, Gate };
+
+const char* kind_name(Kind k) { return k == Kind::Scene ? "scene" : k == Kind::Sweep ? "sweep" : "gate"; }
+
+struct FileCase {
+  const char* name;
+  Kind kind;
+  std::string text;
+  std::string key;     // the message must start "FILE: KEY: "
+  std::string detail;  // the offending value and the expected range (or the reason), after the key
+  std::vector<std::string> overrides = {};  // scene files only: --set
+  bool cli = false;                         // also through `tippe`: exit 2, the message, nothing written
+};
+
+std::vector<FileCase> file_cases() {
+  const std::string b = kBase, w = kSweepBase, g = kGateBase;
+  const std::string by_density =
+      edit(b, "mass = 1.0\ncom_offset = 0.3\ninertia_transverse = 0.4\ninertia_axial = 0.45\n",
+           "density = 1.0\nmass_model = \"solid\"\n");
+  const std::string drilling = edit(b, "k = 1.0", "k = 1.0\ndrilling = -0.01");
+  const Kind S = Kind::Scene, W = Kind::Sweep, G = Kind::Gate;
+  return {
+      // ---- scene files
+      {"rtol_above_range", S, edit(b, "rtol = 1e-10", "rtol = 2"), "run.rtol",
+       "2 is out of range (expected 1e-15 <= rtol <= 0.01)", {}, true},
+      {"rtol_zero", S, edit(b, "rtol = 1e-10", "rtol = 0"), "run.rtol", "0 is out of range (expected 1e-15 <= rtol"},
+      {"rtol_below_rounding", S, edit(b, "rtol = 1e-10", "rtol = 1e-17"), "run.rtol", "1e-17 is out of range"},
+      {"atol_negative", S, edit(b, "atol = 1e-12", "atol = -1e-12"), "run.atol",
+       "-1e-12 is out of range (expected 0 < atol <= 1)"},
+      {"tilt_negative", S, edit(b, "tilt = 0.1", "tilt = -0.1"), "initial.tilt",
+       "-0.1 is out of range (expected 0 <= tilt <= pi = 3.14159265359 rad)"},
+      {"tilt_just_above_pi", S, edit(b, "tilt = 0.1", "tilt = 3.1416"), "initial.tilt", "3.1416 is out of range"},
+      {"sample_interval_zero", S, edit(b, "sample_interval = 0.01", "sample_interval = 0"), "run.sample_interval",
+       "0 is out of range (expected 0 < sample_interval <= duration = 25)"},
+      {"sample_interval_negative", S, edit(b, "sample_interval = 0.01", "sample_interval = -0.01"),
+       "run.sample_interval", "-0.01 is out of range"},
+      {"duration_negative", S, edit(b, "duration = 25.0", "duration = -1"), "run.duration",
+       "-1 is out of range (expected duration > 0)", {}, true},
+      {"gravity_zero", S, edit(b, "gravity = 1", "gravity = 0"), "gravity", "0 is out of range (expected gravity > 0)"},
+      {"gravity_minus_inf", S, edit(b, "gravity = 1", "gravity = -inf"), "gravity", "must be a finite number, got -inf"},
+      {"spin_nan", S, edit(b, "spin = 5.0", "spin = nan"), "initial.spin", "must be a finite number, got nan"},
+      {"velocity_nan", S, edit(b, "velocity = [0.0, 0.0]", "velocity = [nan, 0.0]"), "initial.velocity[0]",
+       "must be a finite number, got nan"},
+      {"drilling_negative", S, drilling, "contact.drilling", "-0.01 is out of range (expected drilling >= 0)"},
+      {"mass_zero", S, edit(b, "mass = 1.0", "mass = 0"), "body.mass", "0 is out of range (expected mass > 0)"},
+      {"inertia_transverse_negative", S, edit(b, "inertia_transverse = 0.4", "inertia_transverse = -0.4"),
+       "body.inertia_transverse", "-0.4 is out of range (expected inertia_transverse > 0)"},
+      {"inertia_axial_above_2A", S, edit(b, "inertia_axial = 0.45", "inertia_axial = 0.9"), "body.inertia_axial",
+       "0.9 is out of range (expected inertia_axial <= 2 inertia_transverse = 0.8"},
+      {"com_offset_below_minus_R", S, edit(b, "com_offset = 0.3", "com_offset = -1.5"), "body.com_offset",
+       "-1.5 is out of range (expected -R < com_offset < R, R = sphere_radius = 1)"},
+      {"truncation_height_zero", S, edit(b, "truncation_height = 0.9", "truncation_height = 0"),
+       "body.truncation_height", "0 is out of range (expected 0 < truncation_height <= sphere_radius = 1)"},
+      {"stem_length_negative", S, edit(b, "stem_length = 1.2", "stem_length = -1.2"), "body.stem_length",
+       "-1.2 is out of range (expected stem_length > 0)"},
+      {"density_negative", S, edit(by_density, "density = 1.0", "density = -1000"), "body.density",
+       "-1000 is out of range (expected density > 0)"},
+      {"tilt_a_string", S, edit(b, "tilt = 0.1", "tilt = \"0.1\""), "initial.tilt",
+       "expected a number, got a string '0.1'"},
+      {"stem_an_integer", S, edit(b, "k = 1.0", "k = 1.0\nstem = 1"), "contact.stem",
+       "expected true or false, got an integer 1"},
+      {"unknown_run_key", S, edit(b, "atol = 1e-12", "atol = 1e-12\ntolerance = 1e-9"), "run.tolerance",
+       "unknown key (expected one of: duration, sample_interval, rtol, atol, method, self_check)"},
+      {"set_rtol_out_of_range", S, b, "run.rtol", "0.5 is out of range (expected 1e-15 <= rtol <= 0.01)",
+       {"run.rtol=0.5"}, true},
+      {"engine_timestep_out_of_range", S, b + "[engines.ode]\ntimestep = 1\n", "engines.ode.timestep",
+       "value 1 outside [1e-08, 0.1]"},
+      {"engine_iterations_zero", S, b + "[engines.bullet]\nsolver_iterations = 0\n", "engines.bullet.solver_iterations",
+       "value 0 outside [1, 1000000]"},
+
+      // ---- sweep files
+      {"repeats_above_100", W, edit(w, "repeats = 1", "repeats = 101"), "repeats",
+       "101 is out of range (expected 1 <= repeats <= 100)", {}, true},
+      {"repeats_negative", W, edit(w, "repeats = 1", "repeats = -3"), "repeats",
+       "-3 is out of range (expected 1 <= repeats <= 100)"},
+      {"repeats_a_float", W, edit(w, "repeats = 1", "repeats = 2.5"), "repeats",
+       "expected an integer (1 <= repeats <= 100), got a float 2.5"},
+      {"duration_zero", W, edit(w, "duration = 0.5", "duration = 0"), "duration",
+       "0 is out of range (expected duration > 0)"},
+      {"duration_nan", W, edit(w, "duration = 0.5", "duration = nan"), "duration", "must be a finite number, got nan"},
+      {"duration_a_string", W, edit(w, "duration = 0.5", "duration = \"0.5\""), "duration",
+       "expected a number, got a string '0.5'"},
+      {"scene_duration_negative", W,
+       edit(w, "scenes = [\"../scenes/base.toml\"]", "scenes = [{ file = \"../scenes/base.toml\", duration = -2 }]"),
+       "scenes[0].duration", "-2 is out of range (expected duration > 0)"},
+      {"duration_below_sample_interval", W, edit(w, "duration = 0.5", "duration = 0.001"), "duration",
+       "run.sample_interval: 0.01 is out of range (expected 0 < sample_interval <= duration = 0.001)"},
+      {"ladder_timestep_out_of_range", W, edit(w, "ladder.values = [1e-3, 5e-4]", "ladder.values = [1e-3, 0.5]"),
+       "setup[0].ladder.values[1]", "engines.ode.timestep: value 0.5 outside [1e-08, 0.1]", {}, true},
+      {"ladder_rtol_out_of_range", W, edit(w, "ladder.values = [1e-6, 1e-8]", "ladder.values = [1e-6, 0.5]"),
+       "setup[1].ladder.values[1]", "run.rtol: 0.5 is out of range (expected 1e-15 <= rtol <= 0.01)"},
+      {"ladder_value_inf", W, edit(w, "ladder.values = [1e-3, 5e-4]", "ladder.values = [1e-3, inf]"),
+       "setup[0].ladder.values[1]", "must be a finite number, got inf"},
+      // A boolean is a value of a categorical ladder: the engine setting refuses it for a time step.
+      {"ladder_value_a_boolean", W, edit(w, "ladder.values = [1e-3, 5e-4]", "ladder.values = [true]"),
+       "setup[0].ladder.values[0]", "engines.ode.timestep: expected a number"},
+      {"grid_value_the_setting_refuses", W,
+       edit(w, "ladder.values = [1e-3, 5e-4]",
+            "ladder.values = [1e-3, 5e-4]\ngrid = { key = \"engines.ode.friction_model\", values = [\"approx1\", \"cone\"] }"),
+       "setup[0].grid.values[1]", "engines.ode.friction_model: value \"cone\" is not one of: approx1, box"},
+      {"set_iterations_zero", W, edit(w, "engines.ode.iterations=20", "engines.ode.iterations=0"), "setup[0].set[0]",
+       "engines.ode.iterations: value 0 outside [1, 1000000]"},
+      {"unknown_top_key", W, "repeat = 3\n" + w, "repeat",
+       "unknown key (expected one of: description, repeats, duration, scenes, setup)"},
+      {"setup_in_single_brackets", W,
+       edit(w.substr(0, w.find("\n[[setup]]\nname = \"reference\"") + 1), "[[setup]]", "[setup]"), "setup",
+       "expected [[setup]] tables, got a table"},
+
+      // ---- gate files
+      {"threshold_negative", G, edit(g, "tilt_rms_error = 0.05", "tilt_rms_error = -0.05"),
+       "check[0].max.tilt_rms_error", "-0.05 is out of range (expected tilt_rms_error >= 0: |value| is compared)", {},
+       true},
+      {"threshold_nan", G, edit(g, "tilt_rms_error = 0.05", "tilt_rms_error = nan"), "check[0].max.tilt_rms_error",
+       "must be a finite number, got nan"},
+      {"threshold_inf", G, edit(g, "steps = 1000", "steps = inf"), "check[0].max.steps",
+       "must be a finite number, got inf"},
+      {"threshold_minus_inf", G, edit(g, "steps = 1000", "steps = -inf"), "check[0].max.steps",
+       "must be a finite number, got -inf"},
+      {"threshold_a_string", G, edit(g, "tilt_rms_error = 0.05", "tilt_rms_error = \"0.05\""),
+       "check[0].max.tilt_rms_error", "expected a number, got a string '0.05'"},
+      {"threshold_in_defaults_negative", G, edit(g, "duration = 0.5\n", "duration = 0.5\nmax = { steps = -1 }\n"),
+       "defaults.max.steps", "-1 is out of range (expected steps >= 0: |value| is compared)"},
+      {"check_duration_negative", G, edit(g, "engine = \"ode\"\n", "engine = \"ode\"\nduration = -1\n"),
+       "check[0].duration", "-1 is out of range (expected duration > 0)"},
+      {"defaults_duration_nan", G, edit(g, "duration = 0.5", "duration = nan"), "defaults.duration",
+       "must be a finite number, got nan"},
+      {"duration_below_sample_interval", G, edit(g, "duration = 0.5", "duration = 0.001"), "defaults.duration",
+       "run.sample_interval: 0.01 is out of range (expected 0 < sample_interval <= duration = 0.001)"},
+      {"set_timestep_out_of_range", G, edit(g, "engines.ode.timestep=1e-3", "engines.ode.timestep=1"),
+       "check[0].set[0]", "engines.ode.timestep: value 1 outside [1e-08, 0.1]", {}, true},
+      {"set_rtol_out_of_range", G,
+       edit(g, "\"engines.ode.timestep=1e-3\"", "\"engines.ode.timestep=1e-3\", \"run.rtol=2\""), "check[0].set[1]",
+       "run.rtol: 2 is out of range (expected 1e-15 <= rtol <= 0.01)"},
+      {"status_an_integer", G, edit(g, "engine = \"ode\"\n", "engine = \"ode\"\nstatus = 1\n"), "check[0].status",
+       "expected a string, got an integer 1"},
+      {"require_same_events_an_integer", G, edit(g, "engine = \"ode\"\n", "engine = \"ode\"\nrequire_same_events = 1\n"),
+       "check[0].require_same_events", "expected true or false, got an integer 1"},
+      {"unknown_metric", G, edit(g, "steps = 1000", "step = 1000"), "check[0].max.step", "unknown metric"},
+  };
+}
+
+void PrintTo(const FileCase& c, std::ostream* os) { *os << kind_name(c.kind) << "_" << c.name; }
+
+// Writes the case into `dir` (scenes/, sweeps/ or gates/, beside scenes/base.toml) and returns its path.
+std::string write_case(const TempDir& dir, const FileCase& c) {
+  dir.write("scenes/base.toml", kBase);
+  const std::string sub = c.kind == Kind::Scene ? "scenes/" : c.kind == Kind::Sweep ? "sweeps/" : "gates/";
+  return dir.write(sub + c.name + ".toml", c.text);
+}
+
+// Loads a file of its kind. Only SceneError may come out of a malformed one.
+void load_file(Kind kind, const std::string& path, const std::vector<std::string>& overrides) {
+  if (kind == Kind::Scene) load_scene(path, overrides);
+  else if (kind == Kind::Sweep) load_sweep(path);
+  else load_gate_file(path);
+}
+
+struct Outcome {
+  int code = -1;  // exit status, -1 when it did not exit
+  std::string err;
+};
+
+// `tippe ARGS` with stdout to /dev/null and stderr captured (no shell: arguments pass as they are).
+Outcome run_tippe(const std::vector<std::string>& args, const fs::path& err_file) {
+  std::vector<std::string> argv = {std::string(TIPPE_BINARY_DIR) + "/tippe"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  Outcome o;
+  o.code = wait_process(spawn_process(argv, "/dev/null", err_file)).code;
+  o.err = slurp(err_file);
+  return o;
+}
+
+TEST(FileTable, BasesAreValidAndEveryKindIsCovered) {
+  TempDir dir{"tippe-input"};
+  const std::string scene = dir.write("scenes/base.toml", kBase);
+  const std::string sweep = dir.write("sweeps/base.toml", kSweepBase);
+  const std::string gate = dir.write("gates/base.toml", kGateBase);
+  EXPECT_NO_THROW(load_scene(scene));
+  EXPECT_NO_THROW(load_sweep(sweep));
+  EXPECT_NO_THROW(load_gate_file(gate));
+  size_t per_kind[3] = {0, 0, 0}, through_cli[3] = {0, 0, 0};
+  for (const FileCase& c : file_cases()) {
+    ++per_kind[static_cast<int>(c.kind)];
+    through_cli[static_cast<int>(c.kind)] += c.cli ? 1 : 0;
+  }
+  EXPECT_GE(per_kind[0] + per_kind[1] + per_kind[2], 30u);
+  EXPECT_GE(per_kind[1], 8u) << "sweep cases";
+  EXPECT_GE(per_kind[2], 8u) << "gate cases";
+  for (size_t n : through_cli) EXPECT_GE(n, 1u) << "every kind goes through the command at least once";
+}
+
+class FileTable : public ::testing::TestWithParam<FileCase> {};
+
+TEST_P(FileTable, ThrowsSceneErrorNamingFileKeyAndValue) {
+  const FileCase& c = GetParam();
+  TempDir dir{"tippe-input"};
+  const std::string path = write_case(dir, c);
+  std::string msg;
+  try {
+    load_file(c.kind, path, c.overrides);
+    ADD_FAILURE() << "a malformed input was accepted";
+    return;
+  } catch (const SceneError& e) {
+    msg = e.what();
+  } catch (const std::exception& e) {
+    FAIL() << "not a SceneError: " << e.what();
+  }
+  EXPECT_NE(msg.find(std::string(c.name) + ".toml"), std::string::npos) << msg;
+  EXPECT_EQ(msg.rfind(path + ": " + c.key + ": ", 0), 0u) << "want \"" << c.key << "\" first in: " << msg;
+  EXPECT_NE(msg.find(c.detail), std::string::npos) << "want \"" << c.detail << "\" in: " << msg;
+  if (!c.cli) return;
+
+  // The command says the same and exits 2 before writing anything.
+  const fs::path out = dir.path() / "out", err = dir.path() / "stderr.txt";
+  std::vector<std::string> args;
+  if (c.kind == Kind::Scene) {
+    args = {"run", path, "--out", out.string()};
+    for (const auto& o : c.overrides) args.insert(args.end(), {"--set", o});
+  } else if (c.kind == Kind::Sweep) {
+    args = {"sweep", path, "--out", out.string(), "--no-plots"};
+  } else {
+    args = {"gate", path, "--junit", (out / "junit.xml").string(), "--json", (out / "gate.json").string(),
+            "--cache", (out / "cache").string()};
+  }
+  const Outcome o = run_tippe(args, err);
+  EXPECT_EQ(o.code, 2) << o.err;
+  EXPECT_NE(o.err.find(msg), std::string::npos) << "the command's message differs from the loader's: " << o.err;
+  EXPECT_FALSE(fs::exists(out)) << "an invalid input wrote output";
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, FileTable, ::testing::ValuesIn(file_cases()),
+                         [](const ::testing::TestParamInfo<FileCase>& info) {
+                           return std::string(kind_name(info.param.kind)) + "_" + info.param.name;
+                         });
+
+// What the valid odd inputs load as.
+TEST(InputTable, OddButValidInputsMeanWhatTheySay) {
+  const std::string b = kBase;
+  const Scene zero = parse_scene_text(edit(b, "tilt = 0.1", "tilt = -0.0"), "z.toml");
+  EXPECT_EQ(zero.initial.tilt, 0.0);
+  const Scene plain = parse_scene_text(b, "p.toml");
+  const Scene crlf = parse_scene_text(replace_all(b, "\n", "\r\n"), "p.toml");
+  EXPECT_EQ(scene_to_json(crlf).at("body"), scene_to_json(plain).at("body"));
+  EXPECT_NE(crlf.content_hash, plain.content_hash);  // the hash is over the bytes
+  const Scene hex = parse_scene_text(edit(b, "gravity = 1", "gravity = 0x10"), "h.toml");
+  EXPECT_EQ(hex.gravity, 16.0);
+  const Scene bare = parse_scene_text(b, "s.toml", {"description=\"abc"});
+  EXPECT_EQ(bare.description, "\"abc");
+  const Scene utf8 = parse_scene_text(b, "s.toml", {"description=caf\xc3\xa9"});
+  EXPECT_NE(scene_to_json(utf8).dump().find("caf\xc3\xa9"), std::string::npos);
+}
+
+TEST(InputTable, InMemoryParserTouchesNoFile) {
+  // A label that names no file: parse_scene_text must not try to open it.
+  const Scene s = parse_scene_text(kBase, "/nonexistent/dir/x.toml");
+  EXPECT_EQ(s.source_file, "/nonexistent/dir/x.toml");
+  EXPECT_EQ(s.name, "base");
+  const std::string msg = error_of([] { parse_scene_text("gravity = 0\n", "in-memory/scene.toml"); });
+  EXPECT_EQ(msg, "in-memory/scene.toml: gravity: 0 is out of range (expected gravity > 0)");
+}
+
+// ---- records read back (summary.json, comparison.json, the reference cache) -----------------
+
+// Counts in a record must be JSON integers: found by fuzz_records, a float like 1e300 reached
+// json::get<long long>, a conversion with undefined behaviour (UBSan: "outside the range of
+// representable values of type 'long long'"); now it is a json exception like any mistyped field.
+TEST(RecordInputs, CountsMustBeIntegers) {
+  const nlohmann::json good = to_json(RunRecord{});
+  EXPECT_NO_THROW(from_json(good));
+  const struct {
+    const char* where;
+    const char* key;
+    nlohmann::json value;
+  } bad[] = {{"", "samples", 1e300},        {"", "samples", -1e30},       {"", "samples", 2.5},
+             {"", "samples", "8001"},       {"work", "steps", 1e19},      {"work", "rhs_evaluations", nullptr},
+             {"work", "solver_iterations", 18446744073709551615ULL}};
+  for (const auto& c : bad) {
+    nlohmann::json j = good;
+    (*c.where ? j[c.where] : j)[c.key] = c.value;
+    EXPECT_THROW(from_json(j), nlohmann::json::exception) << c.where << "." << c.key << " = " << c.value.dump();
+  }
+  nlohmann::json big = good;
+  big["samples"] = 9223372036854775807LL;
+  EXPECT_EQ(from_json(big).samples, 9223372036854775807LL);
+
+  const nlohmann::json metrics = to_json(Metrics{});
+  EXPECT_NO_THROW(metrics_from_json(metrics));
+  for (const char* key : {"steps", "energy_gain_events"}) {
+    nlohmann::json j = metrics;
+    j[key] = 1e300;
+    EXPECT_THROW(metrics_from_json(j), nlohmann::json::exception) << key;
+  }
+}
+
+}  // namespace

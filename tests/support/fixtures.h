@@ -1,0 +1,100 @@
+// The fixtures the test programs share: the dimensionless test top as a Scene and as scene-file text, bit-exact comparisons, paths.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+
+#include "scene.h"
+#include "simulator.h"
+#include "support/files.h"
+#include "support/process.h"
+#include "support/records.h"
+
+namespace tippe::fixtures {
+
+// The source tree, the build tree and the `tippe` binary the tests run.
+inline const std::string kSourceDir = TIPPE_SOURCE_DIR;
+inline const std::string kTippeBinary = std::string(TIPPE_BINARY_DIR) + "/tippe";
+inline const std::string kScenesDir = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/";
+
+// The dimensionless top: g = R = M = 1, mass properties given directly.
+inline Scene dimensionless_scene() {
+  Scene s;
+  s.name = "dimensionless";
+  s.gravity = 1.0;
+  s.body.sphere_radius = 1.0;
+  s.body.stem_radius = 0.25;
+  s.body.stem_length = 1.2;
+  s.body.truncation_height = 0.9;
+  s.body.mass_model = MassModel::Given;
+  s.mass.mass = 1.0;
+  s.mass.com_offset = 0.3;
+  s.mass.inertia_transverse = 0.4;
+  s.mass.inertia_axial = 0.45;
+  s.contact.friction = FrictionLaw::Coulomb;
+  s.contact.mu = 0.3;
+  s.contact.stem = true;
+  s.initial.tilt = 0.1;
+  s.initial.spin = 5.0;
+  s.run.duration = 2.0;
+  s.run.sample_interval = 0.01;
+  return s;
+}
+
+// The same top as a scene file (given mass properties, so nothing depends on the
+// mass-properties code): a valid file the input tests edit one key at a time.
+inline const char* const kBase = R"(name = "base"
+description = "test scene"
+gravity = 1
+[body]
+sphere_radius = 1.0
+stem_radius = 0.25
+stem_length = 1.2
+truncation_height = 0.9
+mass = 1.0
+com_offset = 0.3
+inertia_transverse = 0.4
+inertia_axial = 0.45
+[contact]
+friction = "viscous"
+k = 1.0
+[initial]
+tilt = 0.1
+spin = 5.0
+velocity = [0.0, 0.0]
+[run]
+duration = 25.0
+sample_interval = 0.01
+rtol = 1e-10
+atol = 1e-12
+)";
+
+// Replaces the one occurrence of `from` in `text` (the test fails if there is none).
+inline std::string edit(const std::string& text, const std::string& from, const std::string& to) {
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << "fixture text not found: " << from;
+  if (pos == std::string::npos) return text;
+  return text.substr(0, pos) + to + text.substr(pos + from.size());
+}
+
+inline bool bit_equal(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Two states equal to the last bit (determinism, round trips).
+inline bool bit_equal(const BodyState& a, const BodyState& b) {
+  bool eq = bit_equal(a.t, b.t);
+  for (int i = 0; i < 3; ++i)
+    eq = eq && bit_equal(a.p_WG[i], b.p_WG[i]) && bit_equal(a.v_WG[i], b.v_WG[i]) && bit_equal(a.w_B[i], b.w_B[i]);
+  for (int i = 0; i < 4; ++i) eq = eq && bit_equal(a.q_WB.coeffs()[i], b.q_WB.coeffs()[i]);
+  return eq;
+}
+
+// A simulator's setting as it lists it, or "<missing>".
+inline std::string setting_value(const SettingsList& list, const std::string& key) {
+  for (const auto& kv : list)
+    if (kv.first == key) return kv.second;
+  return "<missing>";
+}
+
+}  // namespace tippe::fixtures
