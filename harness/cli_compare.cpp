@@ -9,7 +9,7 @@
 #include "registry.h"
 #include "cli.h"
 #include "compare.h"
-#include "report.h"
+#include "report/report.h"
 #include "scene_io.h"
 
 namespace tippe::cli {

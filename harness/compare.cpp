@@ -25,7 +25,7 @@
 #include "interrupt.h"
 #include "mass_properties.h"
 #include "provenance.h"
-#include "report.h"
+#include "report/report.h"
 #include "scene_io.h"
 #include "task_farm.h"
 

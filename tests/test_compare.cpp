@@ -14,9 +14,9 @@
 #include <sstream>
 
 #include "compare.h"
-#include "gnuplot.h"
+#include "report/gnuplot.h"
 #include "records.h"
-#include "report.h"
+#include "report/report.h"
 #include "scene_io.h"
 #include "test_files.h"
 

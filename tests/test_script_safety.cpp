@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "gnuplot.h"
+#include "report/gnuplot.h"
 #include "test_files.h"
 #include "test_process.h"
 

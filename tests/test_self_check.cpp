@@ -8,7 +8,7 @@
 
 #include "compare.h"
 #include "records.h"
-#include "report.h"
+#include "report/report.h"
 #include "scene_io.h"
 #include "test_files.h"
 

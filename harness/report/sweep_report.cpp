@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "registry.h"
-#include "gnuplot.h"
+#include "report/gnuplot.h"
 #include "records.h"
-#include "report.h"
+#include "report/report.h"
 #include "sweep.h"
 #include "sweep_search.h"
 

@@ -1,5 +1,5 @@
 // Runs gnuplot on a script the program wrote, without a shell, and quotes only the program's own strings into it.
-#include "gnuplot.h"
+#include "report/gnuplot.h"
 
 #include <fcntl.h>
 #include <spawn.h>

@@ -1,5 +1,5 @@
 // Comparison reports from records alone: Markdown for terminals and CI logs, a self-contained HTML page, gnuplot SVG plots.
-#include "report.h"
+#include "report/report.h"
 
 #include "registry.h"
 
@@ -14,7 +14,7 @@
 #include <utility>
 
 #include "compare.h"
-#include "gnuplot.h"
+#include "report/gnuplot.h"
 #include "records.h"
 
 namespace tippe {
