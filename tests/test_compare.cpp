@@ -576,7 +576,7 @@ TEST(Report, WithoutGnuplotThePageSaysPlotsSkipped) {
   EXPECT_EQ(html.find("<img"), std::string::npos);
   EXPECT_NE(html.find("plots skipped"), std::string::npos);
   EXPECT_NE(slurp(dir.path() / "report.md").find("plots skipped"), std::string::npos);
-  EXPECT_NE(html.find("<table class=\"summary\">"), std::string::npos);
+  EXPECT_NE(html.find("<table class=\"summary num\">"), std::string::npos);
 
   {
     EnvGuard env("TIPPE_GNUPLOT", (dir.path() / "no-such-gnuplot").c_str());
