@@ -1,6 +1,7 @@
 // What the sweep report's files share: the records grouped by scene and setup, the text of settings, and the charts (sweep_charts.cpp).
 #pragma once
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -17,6 +18,25 @@ inline std::string fmt(const char* f, double v) {
   return buf;
 }
 inline std::string last_part(const std::string& key) { return key.substr(key.rfind('.') + 1); }
+inline std::string g3(double v) { return std::isfinite(v) ? fmt("%.3g", v) : "-"; }
+inline std::string pct(double v) { return std::isfinite(v) ? fmt("%.3g", 100 * v) + " %" : "-"; }
+inline std::string pct(const std::optional<double>& v) { return v ? pct(*v) : "-"; }
+inline std::string time_text(const std::optional<double>& t) { return t ? fmt("%.6g", *t) : "none"; }
+inline std::string join_list(const std::vector<std::string>& v, const char* sep) {
+  std::string t;
+  for (const auto& x : v) t += (t.empty() ? "" : sep) + x;
+  return t;
+}
+inline std::string setting_text(const SweepRecord& r) {
+  return r.ladder_key + " = " + ladder_text(r) + (r.grid_key.empty() ? "" : ", " + r.grid_key + " = " + grid_text(r));
+}
+inline std::string short_setting(const SweepRecord& r) {
+  return last_part(r.ladder_key) + " = " + ladder_text(r) +
+         (r.grid_key.empty() ? "" : ", " + last_part(r.grid_key) + " = " + grid_text(r));
+}
+// A point a setting may be recommended from: the stability map does not class it unphysical or
+// diverged (a run that ends in time with a broken conservation law is no setting to use).
+inline bool recommendable(const SweepRecord& r) { return r.run_class != "unphysical" && r.run_class != "diverged"; }
 
 // The records of one scene, grouped by setup in sweep order.
 struct SetupGroup {
@@ -53,5 +73,13 @@ std::vector<ChartFile> chart_files(const SceneGroup& s, size_t scene);
 // and returns the SVGs that came out; `note` says what is missing.
 std::vector<std::string> render_sweep_charts(const std::filesystem::path& dir, const std::vector<SceneGroup>& scenes,
                                              std::string& note);
+
+// The finding the sweep page opens with: one sentence per engine, from the records alone. Its
+// regime against the reference's (points in it, of its points, per scene), its inversion-time
+// error where both invert, and the setting to use on each scene: the cheapest point below 1 %
+// inversion-time error (10 % when none reaches 1 %) where the reference inverts, the cheapest
+// finished point in the reference's regime where it does not; never a point the stability map
+// classes unphysical or diverged (recommendable).
+std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes);
 
 }  // namespace tippe::sweep_report_detail

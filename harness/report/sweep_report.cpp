@@ -30,13 +30,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace sweep_report_detail;
 
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-std::string g3(double v) { return std::isfinite(v) ? fmt("%.3g", v) : "-"; }
-
-std::string pct(double v) { return std::isfinite(v) ? fmt("%.3g", 100 * v) + " %" : "-"; }
-std::string pct(const std::optional<double>& v) { return v ? pct(*v) : "-"; }
-std::string time_text(const std::optional<double>& t) { return t ? fmt("%.6g", *t) : "none"; }
 
 // The regime table's last column: the verdict and the inversion times it rests on.
 std::string trend_text(const RegimeTrend& tr) {
@@ -47,13 +40,6 @@ std::string trend_text(const RegimeTrend& tr) {
   std::string text = tr.verdict;
   if (tr.in_regime_from) text += " (in the regime from dt = " + fmt("%.3g", *tr.in_regime_from) + " down)";
   return text + "; inverts at " + times;
-}
-std::string setting_text(const SweepRecord& r) {
-  return r.ladder_key + " = " + ladder_text(r) + (r.grid_key.empty() ? "" : ", " + r.grid_key + " = " + grid_text(r));
-}
-std::string short_setting(const SweepRecord& r) {
-  return last_part(r.ladder_key) + " = " + ladder_text(r) +
-         (r.grid_key.empty() ? "" : ", " + last_part(r.grid_key) + " = " + grid_text(r));
 }
 
 // A table of text cells, with an optional CSS class per cell (same shape as rows; "" for none).
@@ -85,9 +71,6 @@ std::string class_css(const SweepRecord& r) {
   return "c-" + r.run_class;
 }
 
-// A point a setting may be recommended from: the stability map does not class it unphysical or
-// diverged (a run that ends in time with a broken conservation law is no setting to use).
-bool recommendable(const SweepRecord& r) { return r.run_class != "unphysical" && r.run_class != "diverged"; }
 
 std::string points_text(const std::vector<double>& values, const std::vector<size_t>& used) {
   std::string t;
@@ -351,12 +334,6 @@ std::string choice_verdict(const ChoiceEffect& e) {
   return "does not move the verdict";
 }
 
-std::string join_list(const std::vector<std::string>& v, const char* sep) {
-  std::string t;
-  for (const auto& x : v) t += (t.empty() ? "" : sep) + x;
-  return t;
-}
-
 // "at STEP" of the first step at which the regime differs, and at how many it does.
 std::string regime_where(const ChoiceEffect& e) {
   if (e.regime_at.empty()) return "";
@@ -430,78 +407,6 @@ void choices_section(const std::vector<SweepRecord>& records, Document& doc) {
                       e.reference_inversion ? "inverts at " + fmt("%.5g", *e.reference_inversion) : "does not invert",
                       e.setup, e.key, join_list(e.values, ", "), choice_verdict(e), choice_detail(e)});
   doc.table(to_doc(t));
-}
-
-// The finding the page opens with: one sentence per engine, from the records alone. Its regime
-// against the reference's (points in it, of its points, per scene), its inversion-time error
-// where both invert, and the setting to use on each scene: the cheapest point below 1 %
-// inversion-time error (10 % when none reaches 1 %) where the reference inverts, the cheapest
-// finished point in the reference's regime where it does not; never a point the stability map
-// classes unphysical or diverged.
-std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes) {
-  std::vector<std::string> engines;
-  for (const SceneGroup& s : scenes)
-    for (const SetupGroup& u : s.setups)
-      if (std::find(engines.begin(), engines.end(), u.engine) == engines.end()) engines.push_back(u.engine);
-  std::vector<std::string> out;
-  for (const std::string& e : engines) {
-    size_t agree = 0, total = 0;
-    double lo = kInfinity, hi = -kInfinity;
-    std::vector<std::string> per_scene, use;
-    for (const SceneGroup& s : scenes) {
-      std::vector<SweepRecord> mine, usable_points;
-      for (const SetupGroup& u : s.setups)
-        if (u.engine == e)
-          for (const SweepRecord& r : u.points) {
-            mine.push_back(r);
-            if (recommendable(r)) usable_points.push_back(r);
-          }
-      if (mine.empty()) continue;
-      size_t a = 0;
-      for (const SweepRecord& r : mine) {
-        a += agrees_with_reference_regime(r) && recommendable(r);
-        if (r.metrics.inversion_event == "both" && r.metrics.inversion_time_rel_error &&
-            std::isfinite(*r.metrics.inversion_time_rel_error)) {
-          lo = std::min(lo, std::abs(*r.metrics.inversion_time_rel_error));
-          hi = std::max(hi, std::abs(*r.metrics.inversion_time_rel_error));
-        }
-      }
-      agree += a;
-      total += mine.size();
-      per_scene.push_back(s.name + " " + std::to_string(a) + "/" + std::to_string(mine.size()));
-      const auto pick = [&](const SweepRecord& r, const std::string& why) {
-        use.push_back("on " + s.name + " " + r.setup + " " + short_setting(r) + " (" + why + ", " + g3(r.cpu_seconds) +
-                      " CPU s)");
-      };
-      if (s.reference_inversion) {
-        long long i = cheapest_below(usable_points, 0.01);
-        if (i >= 0) {
-          const SweepRecord& r = usable_points[static_cast<size_t>(i)];
-          pick(r, "the cheapest below 1 %: " + pct(std::abs(*r.metrics.inversion_time_rel_error)));
-        } else if ((i = cheapest_below(usable_points, 0.1)) >= 0) {
-          const SweepRecord& r = usable_points[static_cast<size_t>(i)];
-          pick(r, "none reaches 1 %; the cheapest below 10 %: " + pct(std::abs(*r.metrics.inversion_time_rel_error)));
-        } else {
-          use.push_back("on " + s.name + " none (no point within 10 % of the reference's inversion time)");
-        }
-      } else {
-        const SweepRecord* best = nullptr;
-        for (const SweepRecord& r : usable_points)
-          if (r.status == "ok" && agrees_with_reference_regime(r) && std::isfinite(r.cpu_seconds) &&
-              (!best || r.cpu_seconds < best->cpu_seconds))
-            best = &r;
-        if (best) pick(*best, "the cheapest in the reference's regime");
-        else use.push_back("on " + s.name + " none (no finished point in the reference's regime)");
-      }
-    }
-    std::string t = e + ": in the reference's regime at " + std::to_string(agree) + " of " + std::to_string(total) +
-                    " points (" + join_list(per_scene, ", ") + "; unphysical and diverged runs never count); ";
-    t += lo <= hi ? "inversion-time error " + (lo == hi ? pct(lo) : pct(lo) + " to " + pct(hi)) + " where both invert"
-                  : "no point where both invert";
-    t += "; setting to use: " + join_list(use, "; ") + ".";
-    out.push_back(t);
-  }
-  return out;
 }
 
 Document build_doc(const std::vector<SweepRecord>& records, const std::vector<std::string>& images,
