@@ -1,5 +1,6 @@
 // Comparison pages lead with the verdict: one sentence per engine, engine-minus-reference plots on a log axis, contact paths broken at surface switches, plots kept when they cannot be remade.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -309,4 +310,23 @@ TEST(ReportDocument, OneModelRenderedToMarkdownAndHtml) {
   EXPECT_NE(md.find("## Provenance\n\n- commit abc"), std::string::npos) << md;
   d.toc_from = 5;
   EXPECT_EQ(render_document_html(d).find("<nav class=\"toc\">"), std::string::npos) << "a short page has none";
+}
+
+TEST(ReportIndex, TheCommandReadsEverySceneDirectory) {
+  TempDir dir{"tippe-pages"};
+  fs::create_directories(dir.path() / "fixture");
+  fs::create_directories(dir.path() / "sweep-x");  // no comparison.json: not a scene page
+  make_comparison(dir.path() / "fixture");
+  const std::string tippe = std::string(TIPPE_BINARY_DIR) + "/tippe";
+  const fs::path out = dir.path() / "out.txt";
+  ASSERT_EQ(std::system((tippe + " report " + dir.path().string() + " --index-verdict >" + out.string()).c_str()), 0);
+  const std::string text = slurp(out);
+  EXPECT_EQ(text,
+            "ode: the reference's regime on 1 of 1 scenes; inversion-time error 5 % on the 1 scene where both invert "
+            "(largest on fixture).\n"
+            "bullet: the reference's regime on 0 of 1 scenes; the wrong regime on fixture (does not invert); no scene "
+            "where both invert.\n");
+  // A directory with no comparison in it is bad input, exit 2.
+  const int rc = std::system((tippe + " report " + (dir.path() / "sweep-x").string() + " --index-verdict 2>/dev/null").c_str());
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
 }
