@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "report/gnuplot.h"
 #include "report/report.h"
 #include "sweep.h"
 #include "test_files.h"
@@ -71,8 +72,7 @@ TEST(SweepVerdict, RegimeErrorAndTheSettingToUse) {
   const std::string md = render_sweep_markdown(fixture());
   const std::string v = verdict_line(md, "ode");
   EXPECT_EQ(v,
-            "ode: in the reference's regime at 5 of 6 points (inverting 3/3, rolling 2/3; unphysical and diverged runs "
-            "never count); inversion-time error 0.01 % to 5 % where both invert; setting to use: on inverting ode "
+            "ode: in the reference's regime at 5 of 6 points (inverting 3/3, rolling 2/3); inversion-time error 0.01 % to 5 % where both invert; setting to use: on inverting ode "
             "timestep = 0.001 (the cheapest below 1 %: 0.5 %, 1 CPU s); on rolling ode timestep = 0.001 (the cheapest "
             "in the reference's regime, 1 CPU s).")
       << md;
@@ -99,6 +99,7 @@ TEST(SweepVerdict, AnUnphysicalOrDivergedPointIsNeverRecommended) {
   EXPECT_NE(md.find("| ode | 1 % | ode | engines.ode.timestep = 0.0001 |"), std::string::npos) << md;
   EXPECT_EQ(md.find("| ode | 1 % | ode | engines.ode.timestep = 0.001 |"), std::string::npos) << md;
   EXPECT_NE(md.find("left out, whatever their error"), std::string::npos);
+  EXPECT_NE(md.find("unphysical or diverged never count, nor are they ever the setting to use"), std::string::npos);
 }
 
 TEST(SweepVerdict, EveryPointTableCarriesTheClass) {
@@ -124,4 +125,27 @@ TEST(SweepVerdict, HtmlPageColoursTheClassAndLinksTheRecords) {
   EXPECT_NE(html.find("<a href=\"../index.html\">all reports</a>"), std::string::npos);
   EXPECT_NE(html.find("<nav class=\"toc\">"), std::string::npos);
   EXPECT_EQ(html.find("<script"), std::string::npos);
+}
+
+TEST(SweepCharts, NamedByTheScenesPlaceAndStaleChartsGo) {
+  if (gnuplot_command().empty()) GTEST_SKIP() << "gnuplot not installed";
+  TempDir dir{"tippe-sweep-page"};
+  spit(dir.path() / "wp-old_scene-tilt_rms_error.svg", "<svg>stale</svg>");
+  spit(dir.path() / "regime-old_scene.svg", "<svg>stale</svg>");
+  spit(dir.path() / "notes.svg", "<svg>not a chart</svg>");
+  write_sweep_report(dir.path().string(), fixture(), true);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "wp-old_scene-tilt_rms_error.svg"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "regime-old_scene.svg"));
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "notes.svg")) << "only the report's own charts are removed";
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "wp-s1-inversion_time_rel_error.svg"));
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "regime-s2.svg")) << "the rolling scene's regime chart";
+  // Neither a scene's name nor a setup's reaches the script; each axis says its unit.
+  const std::string gp = slurp(dir.path() / "sweep-plots.gp");
+  EXPECT_EQ(gp.find("inverting"), std::string::npos) << gp;
+  EXPECT_EQ(gp.find("rolling"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("set xlabel 'CPU seconds of the run (s;"), std::string::npos);
+  EXPECT_NE(gp.find("(dimensionless)'"), std::string::npos);
+  EXPECT_NE(gp.find("(scene time unit;"), std::string::npos);
+  const std::string html = slurp(dir.path() / "index.html");
+  EXPECT_NE(html.find("<img src=\"wp-s1-inversion_time_rel_error.svg\""), std::string::npos);
 }

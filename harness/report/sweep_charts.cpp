@@ -132,6 +132,17 @@ std::vector<std::string> render_sweep_charts(const fs::path& dir, const std::vec
     note = why;
     return made;
   }
+  // Charts of an earlier report (other scenes, or names of an older version) would be left
+  // beside the new ones and copied with them: every chart comes from the records, so all go.
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const auto ends = [&](const std::string& tail) {
+      return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+    };
+    if ((name.rfind("wp-", 0) == 0 || name.rfind("regime-", 0) == 0) && ends(".svg")) fs::remove(entry.path(), ec);
+    else if (name.rfind("sweep-", 0) == 0 && ends(".dat")) fs::remove(entry.path(), ec);
+  }
   std::vector<Chart> charts;
   for (size_t k = 0; k < scenes.size(); ++k) {
     const auto c = make_charts(scenes[k], k);

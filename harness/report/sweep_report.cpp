@@ -419,7 +419,13 @@ Document build_doc(const std::vector<SweepRecord>& records, const std::vector<st
                    {"report.md", "report.md"}};
   const std::vector<SceneGroup> scenes = group(records);
   doc.heading(1, "Work-precision sweep");
-  for (const std::string& v : sweep_verdicts(scenes)) doc.para(v, "verdict");
+  const std::vector<std::string> verdicts = sweep_verdicts(scenes);
+  for (const std::string& v : verdicts) doc.para(v, "verdict");
+  if (!verdicts.empty())
+    doc.para("A point counts as in the reference's regime when it inverts where the reference does and finishes "
+             "without inverting where it does not; points the stability map classes unphysical or diverged never "
+             "count, nor are they ever the setting to use.",
+             "note");
   size_t points = 0;
   std::set<std::string> setups, commits;
   std::map<std::string, std::string> versions;

@@ -71,7 +71,7 @@ std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes) {
       }
     }
     std::string t = e + ": in the reference's regime at " + std::to_string(agree) + " of " + std::to_string(total) +
-                    " points (" + join_list(per_scene, ", ") + "; unphysical and diverged runs never count); ";
+                    " points (" + join_list(per_scene, ", ") + "); ";
     t += lo <= hi ? "inversion-time error " + (lo == hi ? pct(lo) : pct(lo) + " to " + pct(hi)) + " where both invert"
                   : "no point where both invert";
     t += "; setting to use: " + join_list(use, "; ") + ".";
