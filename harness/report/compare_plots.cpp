@@ -291,7 +291,12 @@ PlotSet render_plots(const std::string& out_dir, const json& c) {
 
   GpPage page;
   page.comment = "Plots of the comparison in this directory (written by tippe; regenerate with `tippe report DIR`).";
-  write_file_atomic((dir / "plots.gp").string(), gnuplot_script(page, plot_figures(series, c)));
+  const std::vector<GpFigure> figures = plot_figures(series, c);
+  // A plot this run has no data for (an engine that matches the reference exactly has no
+  // difference to draw) must not be shown from an earlier run's file.
+  for (const GpFigure& f : figures)
+    if (f.series.empty()) fs::remove(dir / f.output, ec);
+  write_file_atomic((dir / "plots.gp").string(), gnuplot_script(page, figures));
   const int code = run_gnuplot(gnuplot, dir, "plots.gp", "plots.log");
   if (code != 0)
     return keep_existing(code == 127 ? "plots skipped: gnuplot not found (" + gnuplot + ")"
