@@ -39,10 +39,13 @@ for scene in harness/scenes/*.toml; do
   "$tippe" compare "$scene" --out "$work/$name" --jobs "$jobs" --no-cache
   rm -rf "${reports:?}/$name"
   mkdir -p "$reports/$name"
-  cp "$work/$name/comparison.json" "$work/$name/report.md" "$work/$name/index.html" "$reports/$name/"
+  cp "$work/$name/comparison.json" "$reports/$name/"
   for svg in "$work/$name"/*.svg; do
     [ -e "$svg" ] && cp "$svg" "$reports/$name/"
   done
+  # The pages from the published files alone: they link only what is published (no trajectory
+  # CSVs) and show the plots made from the trajectories in the scratch directory.
+  "$tippe" report "$reports/$name" >/dev/null
   summary="$("$tippe" report "$work/$name" --summary-line)"
   rows+="<tr><th><a href=\"$name/index.html\">$(printf '%s' "$name" | html_escape)</a></th>"
   rows+="<td>$(scene_description "$scene" | html_escape)</td><td>$(printf '%s' "$summary" | html_escape)</td></tr>"$'\n'

@@ -253,7 +253,7 @@ PlotSet render_plots(const std::string& out_dir, const json& c) {
   auto keep_existing = [&](const std::string& why) {
     for (const auto& f : plot_file_names())
       if (fs::exists(dir / f, ec) && fs::file_size(dir / f, ec) > 0) result.files.push_back(f);
-    result.note = why + (result.files.empty() ? "" : "; the plots shown are kept from an earlier run");
+    result.note = why + (result.files.empty() ? "" : "; the plots shown are kept from an earlier run that had them");
     return result;
   };
   std::string why;
@@ -287,7 +287,9 @@ PlotSet render_plots(const std::string& out_dir, const json& c) {
   for (const json& e : c.at("engines")) add(str(e, "engine"), str(e, "engine"), e.at("summary"), false);
   std::string missing_text;
   for (const auto& m : missing) missing_text += (missing_text.empty() ? "" : ", ") + m;
-  if (series.empty()) return keep_existing("plots not remade: no trajectory in the directory (" + missing_text + ")");
+  if (series.empty())
+    return keep_existing("plots not remade here: this directory holds no trajectory (" + missing_text +
+                         "), from which they are drawn");
 
   GpPage page;
   page.comment = "Plots of the comparison in this directory (written by tippe; regenerate with `tippe report DIR`).";
