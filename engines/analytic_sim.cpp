@@ -176,7 +176,7 @@ const EngineInfo& analytic_engine_info() {
     set_settings_struct<AnalyticSettings>(e);
     e.adopt = adopt_reference_settings;
     e.version = reference_version();
-    e.colour = "#9467bd";
+    e.colour = "#CC79A7";  // Okabe-Ito reddish purple (colour-blind-safe palette)
     return e;
   }();
   return info;

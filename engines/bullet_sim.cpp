@@ -635,7 +635,7 @@ const EngineInfo& bullet_engine_info() {
     e.make = make_bullet_simulator;
     set_settings_struct<BulletSettings>(e);
     e.version = "bullet " + std::to_string(BT_BULLET_VERSION / 100) + "." + std::to_string(BT_BULLET_VERSION % 100);
-    e.colour = "#d62728";
+    e.colour = "#D55E00";  // Okabe-Ito vermillion
     return e;
   }();
   return info;

@@ -359,7 +359,7 @@ const EngineInfo& dart_engine_info() {
     e.make = make_dart_simulator;
     set_settings_struct<DartSettings>(e);
     e.version = std::string("dart ") + DART_VERSION;
-    e.colour = "#ff7f0e";
+    e.colour = "#E69F00";  // Okabe-Ito orange
     return e;
   }();
   return info;

@@ -673,7 +673,7 @@ const EngineInfo& mujoco_engine_info() {
     e.validate = validate_mujoco_settings;
     e.default_settings = [] { return list_settings(MujocoSettings{}); };
     e.version = std::string("mujoco ") + mj_versionString();
-    e.colour = "#2ca02c";
+    e.colour = "#009E73";  // Okabe-Ito bluish green
     return e;
   }();
   return info;

@@ -530,7 +530,7 @@ const EngineInfo& ode_engine_info() {
     e.make = make_ode_simulator;
     set_settings_struct<OdeSettings>(e, [](const OdeSettings& s, const Scene& scene) { check_combination(s, scene); });
     e.version = std::string("ode ") + dODE_VERSION;
-    e.colour = "#1f77b4";
+    e.colour = "#0072B2";  // Okabe-Ito blue
     return e;
   }();
   return info;

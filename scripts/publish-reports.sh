@@ -39,14 +39,24 @@ for scene in harness/scenes/*.toml; do
   "$tippe" compare "$scene" --out "$work/$name" --jobs "$jobs" --no-cache
   rm -rf "${reports:?}/$name"
   mkdir -p "$reports/$name"
-  cp "$work/$name/comparison.json" "$work/$name/report.md" "$work/$name/index.html" "$reports/$name/"
+  cp "$work/$name/comparison.json" "$reports/$name/"
   for svg in "$work/$name"/*.svg; do
     [ -e "$svg" ] && cp "$svg" "$reports/$name/"
   done
+  # The pages from the published files alone: they link only what is published (no trajectory
+  # CSVs) and show the plots made from the trajectories in the scratch directory.
+  "$tippe" report "$reports/$name" >/dev/null
   summary="$("$tippe" report "$work/$name" --summary-line)"
   rows+="<tr><th><a href=\"$name/index.html\">$(printf '%s' "$name" | html_escape)</a></th>"
   rows+="<td>$(scene_description "$scene" | html_escape)</td><td>$(printf '%s' "$summary" | html_escape)</td></tr>"$'\n'
 done
+
+# The finding the index opens with: one sentence per engine over every scene's comparison.json.
+verdicts="$("$tippe" report "$reports" --index-verdict)"
+verdict_html=""
+while IFS= read -r line; do
+  [ -n "$line" ] && verdict_html+="<p class=\"verdict\">$(printf '%s' "$line" | html_escape)</p>"$'\n'
+done <<<"$verdicts"
 
 commit="$(git -C "$root" rev-parse --short=12 HEAD 2>/dev/null || echo unknown)"
 if [ -n "$(git -C "$root" status --porcelain 2>/dev/null | head -n 1)" ]; then commit="$commit (working tree with changes)"; fi
@@ -63,11 +73,12 @@ body { font-family: system-ui, sans-serif; margin: 1.5em auto; max-width: 1100px
 table { border-collapse: collapse; } th, td { border: 1px solid #ccc; padding: 0.3em 0.6em; text-align: left; vertical-align: top; }
 thead th { background: #f0f0f0; }
 footer { margin-top: 2em; font-size: 0.85em; color: #555; }
+.verdict { background: #eef4fb; border-left: 4px solid #0072b2; padding: 0.4em 0.8em; margin: 0.3em 0; }
 </style>
 </head>
 <body>
 <h1>Tippe top: engines against the analytic reference</h1>
-<p>One page per scene: the Bullet, ODE, MuJoCo and DART engines run on the same scene as the analytic
+${verdict_html}<p>One page per scene: the Bullet, ODE, MuJoCo and DART engines run on the same scene as the analytic
 reference model and are compared sample by sample. How to read a page: README.md in this directory.</p>
 <table>
 <thead><tr><th>scene</th><th>description</th><th>inversion (reference and engines)</th></tr></thead>
@@ -90,9 +101,12 @@ ${rows}</tbody>
 EOF
 mv "$reports/index.html.tmp" "$reports/index.html"
 
-cat >"$reports/README.md.tmp" <<'EOF'
-# Published comparison reports
-
+{
+printf '# Published comparison reports\n\n'
+printf 'The verdict over every scene (one sentence per engine, from the comparison.json files):\n\n'
+printf '%s\n' "$verdicts" | sed 's/^/- /'
+printf '\n'
+cat <<'EOF'
 `index.html` lists every shipped scene (`harness/scenes/*.toml`); each `SCENE/` directory holds
 one comparison of the Bullet, ODE, MuJoCo and DART engines against the analytic reference model:
 
@@ -116,7 +130,8 @@ From the repository root, with the `tippe` target built in `build/`:
 `JOBS=N` sets how many runs go in parallel (default: one per core). The script runs
 `tippe compare SCENE.toml --out TMP --no-cache` for every scene (a fresh reference, not the cache),
 copies the pages, records and plots into `reports/SCENE/`, and rewrites this file and `index.html`.
-One page can also be rebuilt from its records alone with `tippe report DIR` (plots need the CSVs).
+One page can also be rebuilt from its records alone with `tippe report DIR` (plots need the CSVs;
+without them the SVGs already there are kept).
 
 ## Sweeps and the extremes battery
 
@@ -124,10 +139,15 @@ One page can also be rebuilt from its records alone with `tippe report DIR` (plo
 `sweep-boundaries/` (`SWEEP=harness/sweeps/NAME.toml scripts/publish-sweep.sh build`), `sweep-extremes/` and
 `sweep-extremes-long/` (`scripts/publish-extremes.sh build`) are sweep reports: `index.html` and `report.md` are made from
 `records.jsonl` alone (one line per run: settings, status, class, errors against the reference,
-CPU time, steps), `sweep.json` is the sweep file they ran. A sweep report has, per scene, the
+CPU time, steps), `sweep.json` is the sweep file they ran. A sweep report opens with one sentence
+per engine: at how many of its points it is in the reference's regime (per scene), its inversion-time
+error where both invert, and the setting to use on each scene (the cheapest point below 1 %
+inversion-time error, else below 10 %, where the reference inverts; the cheapest finished point in
+the reference's regime where it does not). It then has, per scene, the
 work-precision charts (error against CPU seconds, log-log, one line per setup), the cheapest setting
-of each engine below 10 %, 1 % and 0.1 % inversion-time error, the empirical order of convergence,
-the regime table, and every point. Its stability map gives, per setup, scenes down and the ladder
+of each engine below 10 %, 1 % and 0.1 % inversion-time error (never a point the stability map
+classes unphysical or diverged), the empirical order of convergence,
+the regime table, and every point with its class. Its stability map gives, per setup, scenes down and the ladder
 across, the class of every run: `ok` (green), `ok, regime differs` (yellow: it inverts where the
 reference does not, or the reverse), `unphysical` (orange: energy gain in a dissipative scene, or
 Jellett's integral drifting by more than 1e-3 where it must hold), `clamped` (purple: an engine limit
@@ -171,12 +191,24 @@ has the event; a status other than ok is red. Other metrics are coloured only wh
 carries tolerances. Findings list, in words, events one side lacks, energy gain events and runs that
 ended early.
 
+Every page opens with its verdict: one sentence per engine saying whether it is in the reference's
+regime (inverts when the reference does, and not otherwise) and by how much its inversion time
+differs, taken from comparison.json alone. Links at the top lead back to this index and to the data
+files (comparison.json; the trajectories when the directory has them).
+
 Plots: tilt theta(t) of every engine over the reference (thick black; dashed line at the
-reference's inversion), E(t)/E0, the floor contact path (x_C, y_C), J(t)/J0 and F_n(t)/(M g). Long
-series are decimated to about 2000 points, keeping each stretch's extremes.
+reference's inversion) and |theta - theta_ref| on a log axis, E(t)/E0 and |E - E_ref|/E0 on a log
+axis (the reference interpolated linearly to each engine's sample times), the floor contact path
+(x_C, y_C)/R (the line breaks where the contact switches between the ball and the stem), J(t)/J0
+and F_n(t)/(M g). Every axis carries its unit: seconds for SI scenes, units of sqrt(R/g) for the
+source's dimensionless top. Engines keep one colour from the Okabe-Ito palette (colour-blind safe)
+and one marker on every page. Long series are decimated to about 2000 points, keeping each stretch's
+extremes. `tippe report DIR` remakes the plots from the trajectories; without them (as here) it
+keeps the SVGs that are there.
 
 The footer of each page gives what the numbers depend on: compiler and flags, engine versions, git
 commit, machine, date and the scene file's content hash.
 EOF
+} >"$reports/README.md.tmp"
 mv "$reports/README.md.tmp" "$reports/README.md"
 echo "publish-reports: wrote $reports/index.html" >&2

@@ -9,7 +9,7 @@
 #include "registry.h"
 #include "cli/cli.h"
 #include "measure/compare.h"
-#include "report.h"
+#include "report/report.h"
 #include "io/scene_io.h"
 
 namespace tippe::cli {
@@ -66,8 +66,7 @@ int compare(const CompareCliOptions& o) {
   return 0;
 }
 
-int report(const std::string& dir, bool no_plots, bool summary_line) {
-  const fs::path file = fs::path(dir) / "comparison.json";
+nlohmann::json read_comparison(const fs::path& file) {
   std::ifstream in(file);
   if (!in) throw UsageError(file.string() + ": cannot read (not a comparison directory?)");
   nlohmann::json j;
@@ -79,6 +78,26 @@ int report(const std::string& dir, bool no_plots, bool summary_line) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(file.string() + ": " + e.what());
   }
+  return j;
+}
+
+// One verdict sentence per engine over every DIR/*/comparison.json (the published index's).
+int index_verdict(const std::string& dir) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (fs::exists(entry.path() / "comparison.json")) files.push_back(entry.path() / "comparison.json");
+  if (ec) throw UsageError(dir + ": cannot list (" + ec.message() + ")");
+  if (files.empty()) throw UsageError(dir + ": no SCENE/comparison.json in it");
+  std::sort(files.begin(), files.end());
+  std::vector<nlohmann::json> comparisons;
+  for (const auto& f : files) comparisons.push_back(read_comparison(f));
+  for (const auto& line : index_verdicts(comparisons)) std::printf("%s\n", line.c_str());
+  return 0;
+}
+
+int report(const std::string& dir, bool no_plots, bool summary_line) {
+  const nlohmann::json j = read_comparison(fs::path(dir) / "comparison.json");
   if (summary_line) {
     std::printf("%s\n", render_summary_line(j).c_str());
     return 0;
@@ -119,13 +138,19 @@ Command setup_compare(CLI::App& app) {
 
 Command setup_report(CLI::App& app) {
   auto dir = std::make_shared<std::string>();
-  auto no_plots = std::make_shared<bool>(false), summary_line = std::make_shared<bool>(false);
+  auto no_plots = std::make_shared<bool>(false), summary_line = std::make_shared<bool>(false),
+       index = std::make_shared<bool>(false);
   CLI::App* sub = app.add_subcommand(
       "report", "Regenerate report.md, index.html and plots of a `tippe compare` directory from its records");
   sub->add_option("dir", *dir, "Directory written by tippe compare")->required();
   sub->add_flag("--no-plots", *no_plots, "Skip the gnuplot SVGs");
   sub->add_flag("--summary-line", *summary_line, "Only print who inverts, on one line (writes nothing)");
-  return {sub, [dir, no_plots, summary_line] { return report(*dir, *no_plots, *summary_line); }};
+  sub->add_flag("--index-verdict", *index,
+                "DIR holds one comparison directory per scene: print one verdict sentence per engine over all of "
+                "them (writes nothing)");
+  return {sub, [dir, no_plots, summary_line, index] {
+            return *index ? index_verdict(*dir) : report(*dir, *no_plots, *summary_line);
+          }};
 }
 
 }  // namespace tippe::cli

@@ -14,9 +14,9 @@
 #include <sstream>
 
 #include "measure/compare.h"
-#include "gnuplot.h"
+#include "report/gnuplot.h"
 #include "records/records.h"
-#include "report.h"
+#include "report/report.h"
 #include "io/scene_io.h"
 #include "support/files.h"
 
@@ -529,7 +529,7 @@ TEST(Report, HtmlIsWellFormedWithPlotsAndFooter) {
   const Provenance p = current_provenance();
   for (const std::string& s : {p.compiler, p.git_commit, p.hostname, std::string("0123456789abcdef"),
                                std::string("ode: ode 1.0"), std::string("analytic: analytic 1.0")})
-    EXPECT_NE(foot.find(html_escape(s)), std::string::npos) << s;
+    EXPECT_NE(foot.find(markup_escape(s)), std::string::npos) << s;
   // Escaped text, colours and findings.
   EXPECT_NE(html.find("fixture &lt;scene&gt; &amp; &quot;quotes&quot;"), std::string::npos);
   EXPECT_NE(html.find("&lt;rad/s&gt;"), std::string::npos);
@@ -576,7 +576,7 @@ TEST(Report, WithoutGnuplotThePageSaysPlotsSkipped) {
   EXPECT_EQ(html.find("<img"), std::string::npos);
   EXPECT_NE(html.find("plots skipped"), std::string::npos);
   EXPECT_NE(slurp(dir.path() / "report.md").find("plots skipped"), std::string::npos);
-  EXPECT_NE(html.find("<table class=\"summary\">"), std::string::npos);
+  EXPECT_NE(html.find("<table class=\"summary num\">"), std::string::npos);
 
   {
     EnvGuard env("TIPPE_GNUPLOT", (dir.path() / "no-such-gnuplot").c_str());

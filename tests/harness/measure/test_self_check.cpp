@@ -8,7 +8,7 @@
 
 #include "measure/compare.h"
 #include "records/records.h"
-#include "report.h"
+#include "report/report.h"
 #include "io/scene_io.h"
 #include "support/files.h"
 

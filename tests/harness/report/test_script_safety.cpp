@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "gnuplot.h"
+#include "report/gnuplot.h"
 #include "support/files.h"
 #include "support/process.h"
 

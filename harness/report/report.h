@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "report/document.h"
+
 namespace tippe {
 
 // Every function here reads a comparison.json document (to_json(Comparison)). An optional
@@ -13,6 +15,15 @@ namespace tippe {
 // "amber": b}} makes a value below a green, below b amber, else red (METRIC a key of the
 // metrics, e.g. "tilt_rms_error"). Relative event-time errors default to green below 1 %,
 // amber below 10 %; an event the reference has and the engine lacks (or the reverse) is red.
+
+// The finding the page opens with: one sentence per engine, from the records alone: its regime
+// against the reference's (inverts or not, and when), its inversion-time error, how its run
+// ended when not ok.
+std::vector<std::string> verdict_sentences(const nlohmann::json& comparison);
+
+// The index of many comparisons opens with one sentence per engine over all of them: on how
+// many scenes it is in the reference's regime (and which not), its inversion-time errors.
+std::vector<std::string> index_verdicts(const std::vector<nlohmann::json>& comparisons);
 
 // The summary table in Markdown: the reference, then one row per engine.
 std::string render_summary_table(const nlohmann::json& comparison);
@@ -22,13 +33,18 @@ std::vector<std::string> report_findings(const nlohmann::json& comparison);
 // One line on who inverts: "reference: inverts at t = 17.25 | ode: inverts at t = 17.28 (+0.14 %) |
 // bullet: no inversion (diverged at t = 3.2)"; for indexes of many reports.
 std::string render_summary_line(const nlohmann::json& comparison);
-// report.md: scene, summary table, findings, provenance footer.
-std::string render_markdown(const nlohmann::json& comparison);
-// index.html, self-contained (inline CSS, no scripts, no network). plot_files: SVG names
-// relative to the page, shown in order with captions; plots_note: said where the plots go
-// (e.g. "plots skipped: gnuplot not found"), or below them when some are missing.
+// The page as one document: a back-link to the index and links to the data files, the verdict,
+// the summary table, findings, plots, the scene, every engine's settings and notes, provenance.
+// plot_files: SVG names relative to the page, shown in order with captions; plots_note: said
+// where the plots go (e.g. "plots skipped: gnuplot not found"), or below them when some are
+// missing; data_files: files beside the page to link besides comparison.json (the trajectories).
+Document comparison_document(const nlohmann::json& comparison, const std::vector<std::string>& plot_files,
+                             const std::string& plots_note = "", const std::vector<std::string>& data_files = {});
+// report.md and index.html (self-contained: inline CSS, no scripts, no network) of that document.
+std::string render_markdown(const nlohmann::json& comparison, const std::vector<std::string>& plot_files = {},
+                            const std::string& plots_note = "");
 std::string render_html(const nlohmann::json& comparison, const std::vector<std::string>& plot_files,
-                        const std::string& plots_note = "");
+                        const std::string& plots_note = "", const std::vector<std::string>& data_files = {});
 
 // The SVGs render_plots makes, in page order, and their captions.
 const std::vector<std::string>& plot_file_names();
@@ -40,13 +56,13 @@ struct PlotSet {
 };
 // Writes plots.gp and decimated plot-*.dat files into out_dir from reference.csv and
 // ENGINE.csv there, and runs gnuplot on them. Never throws for a missing gnuplot or trajectory:
-// the note says what is missing.
+// the note says what is missing. Plots it cannot remake (no gnuplot, no trajectory, gnuplot
+// failing) that an earlier run left in out_dir stay and are listed in `files`.
 PlotSet render_plots(const std::string& out_dir, const nlohmann::json& comparison);
 
 // report.md, index.html and (when `plots`) the SVGs in out_dir, from `comparison` and the
 // trajectories beside it; so `tippe report DIR` can regenerate a report from records alone.
+// Without `plots`, SVGs already in out_dir are kept and shown.
 void write_report(const std::string& out_dir, const nlohmann::json& comparison, bool plots);
-
-std::string html_escape(const std::string& text);
 
 }  // namespace tippe

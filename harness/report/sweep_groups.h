@@ -1,0 +1,85 @@
+// What the sweep report's files share: the records grouped by scene and setup, the text of settings, and the charts (sweep_charts.cpp).
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sweep/sweep.h"
+
+namespace tippe::sweep_report_detail {
+
+inline std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+inline std::string last_part(const std::string& key) { return key.substr(key.rfind('.') + 1); }
+inline std::string g3(double v) { return std::isfinite(v) ? fmt("%.3g", v) : "-"; }
+inline std::string pct(double v) { return std::isfinite(v) ? fmt("%.3g", 100 * v) + " %" : "-"; }
+inline std::string pct(const std::optional<double>& v) { return v ? pct(*v) : "-"; }
+inline std::string time_text(const std::optional<double>& t) { return t ? fmt("%.6g", *t) : "none"; }
+inline std::string join_list(const std::vector<std::string>& v, const char* sep) {
+  std::string t;
+  for (const auto& x : v) t += (t.empty() ? "" : sep) + x;
+  return t;
+}
+inline std::string setting_text(const SweepRecord& r) {
+  return r.ladder_key + " = " + ladder_text(r) + (r.grid_key.empty() ? "" : ", " + r.grid_key + " = " + grid_text(r));
+}
+inline std::string short_setting(const SweepRecord& r) {
+  return last_part(r.ladder_key) + " = " + ladder_text(r) +
+         (r.grid_key.empty() ? "" : ", " + last_part(r.grid_key) + " = " + grid_text(r));
+}
+// A point a setting may be recommended from: the stability map does not class it unphysical or
+// diverged (a run that ends in time with a broken conservation law is no setting to use).
+inline bool recommendable(const SweepRecord& r) { return r.run_class != "unphysical" && r.run_class != "diverged"; }
+
+// The records of one scene, grouped by setup in sweep order.
+struct SetupGroup {
+  std::string name, engine, key;
+  std::vector<std::string> set;
+  std::vector<SweepRecord> points;  // grid, then ladder order
+  std::string grid_key;             // empty: no grid
+};
+
+// One line along a setup's ladder: the whole setup, or one grid value of it.
+struct Line {
+  std::string title;  // "SETUP", or "SETUP KEY=VALUE" (KEY the grid key's last part)
+  std::vector<SweepRecord> points;  // ladder order
+};
+std::vector<Line> lines_of(const SetupGroup& u);
+
+struct SceneGroup {
+  std::string name, file;
+  double duration = 0;
+  std::optional<double> reference_inversion, reference_stem_contact;
+  std::vector<SetupGroup> setups;
+};
+// Records deduplicated by point id, in sweep order, grouped by scene then setup.
+std::vector<SceneGroup> group(const std::vector<SweepRecord>& input);
+
+// A chart of one scene: its SVG (named by the scene's place in the sweep, never by a name read
+// from the records) and its caption.
+struct ChartFile {
+  std::string file, caption;
+};
+// The charts made_charts would draw for scene number `scene` (0-based), in page order.
+std::vector<ChartFile> chart_files(const SceneGroup& s, size_t scene);
+// Writes the data and one gnuplot script for every chart of every scene with data, runs gnuplot,
+// and returns the SVGs that came out; `note` says what is missing.
+std::vector<std::string> render_sweep_charts(const std::filesystem::path& dir, const std::vector<SceneGroup>& scenes,
+                                             std::string& note);
+
+// The finding the sweep page opens with: one sentence per engine, from the records alone. Its
+// regime against the reference's (points in it, of its points, per scene), its inversion-time
+// error where both invert, and the setting to use on each scene: the cheapest point below 1 %
+// inversion-time error (10 % when none reaches 1 %) where the reference inverts, the cheapest
+// finished point in the reference's regime where it does not; never a point the stability map
+// classes unphysical or diverged (recommendable).
+std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes);
+
+}  // namespace tippe::sweep_report_detail
