@@ -14,6 +14,7 @@
 #include "io/output_dir.h"
 #include "records/records.h"
 #include "io/scene_io.h"
+#include "report/sweep_analysis.h"
 
 namespace tippe::cli {
 

@@ -11,6 +11,7 @@
 #include "sweep/sweep_search.h"
 #include "io/scene_io.h"
 #include "sweep/sweep.h"
+#include "report/sweep_analysis.h"
 
 namespace tippe::cli {
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "records/records.h"
+#include "io/files.h"
 
 namespace tippe {
 

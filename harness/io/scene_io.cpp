@@ -23,7 +23,7 @@
 
 #include "adapters.h"
 #include "mass_properties.h"
-#include "records/records.h"
+#include "io/files.h"
 
 namespace tippe {
 

@@ -7,7 +7,7 @@
 
 #include "io/scene_io.h"
 #include "io/text.h"
-#include "records/records.h"
+#include "io/files.h"
 
 namespace tippe {
 

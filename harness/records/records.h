@@ -148,7 +148,6 @@ class CsvTrajectoryText : public SampleSink {
 
 // One row of trajectory.csv ('\n' included) into `line`, which holds kTrajectoryRowMax chars;
 // its length. Every number has 17 significant digits, so it reads back to the same double.
-constexpr size_t kTrajectoryRowMax = 27 * 32;
 size_t format_trajectory_row(const Observation& o, char* line);
 std::string trajectory_csv_header();  // '\n' included
 

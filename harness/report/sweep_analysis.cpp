@@ -16,7 +16,7 @@
 
 #include "registry.h"
 #include "records/records.h"
-#include "sweep/sweep.h"
+#include "report/sweep_analysis.h"
 #include "report/sweep_groups.h"
 #include "sweep/sweep_search.h"
 
@@ -129,16 +129,7 @@ long long cheapest_at_least_as_accurate(const std::vector<SweepRecord>& records,
   return cheapest_where(records, [error](double e) { return e <= error; });
 }
 
-bool agrees_with_reference_regime(const SweepRecord& r) {
-  if (r.reference_inversion_time) return r.inversion_time.has_value();
-  return r.status == "ok" && !r.inversion_time;
-}
 
-bool larger_is_softer(const std::string& ladder_key) {
-  const std::string last =
-      ladder_key.substr(ladder_key.rfind('.') == std::string::npos ? 0 : ladder_key.rfind('.') + 1);
-  return last.find("iterations") == std::string::npos && last.find("substeps") == std::string::npos;
-}
 
 long long softest_agreeing(const std::vector<SweepRecord>& records) {
   if (records.empty()) return -1;
@@ -254,12 +245,6 @@ std::vector<SceneGroup> group(const std::vector<SweepRecord>& input) {
 
 using namespace sweep_report_detail;
 
-std::string ladder_text(const SweepRecord& r) {
-  return std::isfinite(r.ladder_value) ? fmt("%g", r.ladder_value) : r.ladder_label;
-}
-std::string grid_text(const SweepRecord& r) {
-  return std::isfinite(r.grid_value) ? fmt("%g", r.grid_value) : r.grid_label;
-}
 
 std::vector<ChoiceEffect> modelling_choices(const std::vector<SweepRecord>& records) {
   std::vector<ChoiceEffect> out;

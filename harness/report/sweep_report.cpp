@@ -22,6 +22,7 @@
 #include "report/document.h"
 #include "report/sweep_groups.h"
 #include "sweep/sweep_search.h"
+#include "report/sweep_analysis.h"
 
 namespace tippe {
 

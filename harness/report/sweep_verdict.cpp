@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "report/sweep_groups.h"
+#include "report/sweep_analysis.h"
 
 namespace tippe::sweep_report_detail {
 

@@ -99,28 +99,6 @@ SweepSearch read_search(const toml::node& node, const std::string& file, const s
   return s;
 }
 
-// ---- criterion --------------------------------------------------------------------------------
-
-SearchCriterion parse_criterion(const std::string& text) {
-  SearchCriterion c;
-  if (trim(text) == "regime") return c;
-  c.regime = false;
-  try {
-    c.bound = parse_threshold_text(text);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(std::string(e.what()) + " (expected \"regime\" or \"METRIC <= BOUND\")");
-  }
-  return c;
-}
-
-bool criterion_passes(const SearchCriterion& c, const SweepRecord& r) {
-  // The regime right means a run that finishes (status ok) in the reference's regime: a run that
-  // inverts at 1.76 s where the reference does at 4.33 s and then falls through the floor (ODE
-  // on toy_viscous at dt 0.0115) is in no sense safe, although the report's regime column, which
-  // only asks whether it inverted, counts it.
-  if (c.regime) return r.status == "ok" && agrees_with_reference_regime(r);
-  return r.status == "ok" && threshold_row(c.bound, r.metrics).passed;
-}
 
 // ---- the search, replayed ---------------------------------------------------------------------
 

@@ -8,19 +8,12 @@
 
 #include <toml++/toml.h>
 
-#include "gating/gate.h"
 #include "sweep/sweep.h"
 
 namespace tippe {
 
 // ---- the file form ----------------------------------------------------------------------------
 
-// Limits of `ladder.search`. The resolution is in log10 units: 1e-3 is a factor of 1.0023, finer
-// than any step a run could tell apart from its neighbour, and far above the 6 significant digits
-// the values are written with; above 1 (a decade) a bracket says little a ladder would not.
-constexpr double kMinSearchResolution = 1e-3, kMaxSearchResolution = 1.0;
-constexpr int kMaxSearchPerDecade = 20;
-constexpr double kMaxSearchDecades = 20;
 // The bisection points of a search's b-th crossing bracket have ladder indices
 // coarse + b * kSearchIndexStride + step: fixed by the bracket and the step, whatever the order in
 // which brackets finish, so that a resumed or sharded search gives every point the same index. A
@@ -33,19 +26,6 @@ constexpr long long kSearchIndexStride = 64;
 // "regime" or "METRIC <= BOUND" (parse_threshold_text, the gate's [check.max] rules);
 // kMinSearchResolution <= resolution <= kMaxSearchResolution; 1 <= per_decade <= kMaxSearchPerDecade.
 SweepSearch read_search(const toml::node& node, const std::string& file, const std::string& where, std::string& key);
-
-// ---- criterion --------------------------------------------------------------------------------
-
-// "regime": in the reference's regime (agrees_with_reference_regime). "METRIC <= BOUND": the run
-// finished (status ok, as a gate check requires by default) and |METRIC| <= BOUND (threshold_row:
-// an absent or NaN metric fails).
-struct SearchCriterion {
-  bool regime = true;
-  Threshold bound;
-};
-// Throws std::invalid_argument with the reason.
-SearchCriterion parse_criterion(const std::string& text);
-bool criterion_passes(const SearchCriterion& c, const SweepRecord& r);
 
 // ---- the search, replayed ---------------------------------------------------------------------
 

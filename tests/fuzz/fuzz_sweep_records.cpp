@@ -7,6 +7,7 @@
 #include <string>
 
 #include "sweep/sweep.h"
+#include "report/sweep_analysis.h"
 
 namespace {
 

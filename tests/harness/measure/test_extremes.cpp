@@ -16,6 +16,7 @@
 #include "io/scene_io.h"
 #include "sweep/sweep.h"
 #include "support/files.h"
+#include "report/sweep_analysis.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

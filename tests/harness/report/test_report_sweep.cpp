@@ -9,6 +9,7 @@
 #include "report/report.h"
 #include "sweep/sweep.h"
 #include "support/files.h"
+#include "report/sweep_analysis.h"
 
 using namespace tippe;
 

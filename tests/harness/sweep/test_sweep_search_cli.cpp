@@ -14,6 +14,7 @@
 #include "support/files.h"
 #include "support/process.h"
 #include "support/records.h"
+#include "report/sweep_analysis.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
