@@ -36,7 +36,7 @@ bool older_spelling(const std::string& key_or_override) {
 
 TEST(ReferenceSettingsSpelling, ShippedScenesUseEnginesAnalytic) {
   const auto scenes = files_under(kHarness / "scenes");
-  ASSERT_GE(scenes.size(), 20u);  // 12 top-level and scaled scenes, 13 extremes
+  ASSERT_GE(scenes.size(), 20u);  // 12 top-level scenes, 1 scaled, 13 extremes
   for (const fs::path& p : scenes) {
     const Scene s = load_scene(p.string());
     EXPECT_TRUE(s.run.alias_keys.empty()) << p << " gives run." << s.run.alias_keys.front();
