@@ -303,9 +303,18 @@ class Chromium {
     write_fd_ = to_browser[1];
     read_fd_ = from_browser[0];
     ::signal(SIGPIPE, SIG_IGN);  // a browser that died is reported by the read, not by a signal
-    const auto target = call("Target.createTarget", {{"url", "about:blank"}});
-    session_ = call("Target.attachToTarget", {{"targetId", target.at("targetId")}, {"flatten", true}}).at("sessionId").get<std::string>();
-    for (const char* domain : {"Runtime.enable", "Log.enable", "Network.enable", "Page.enable"}) call(domain, json::object(), true);
+    try {
+      const auto target = call("Target.createTarget", {{"url", "about:blank"}});
+      session_ = call("Target.attachToTarget", {{"targetId", target.at("targetId")}, {"flatten", true}}).at("sessionId").get<std::string>();
+      for (const char* domain : {"Runtime.enable", "Log.enable", "Network.enable", "Page.enable"}) call(domain, json::object(), true);
+    } catch (...) {
+      // No destructor runs for a constructor that throws: the browser goes here.
+      ::close(write_fd_);
+      ::close(read_fd_);
+      ::kill(-pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+      throw;
+    }
   }
 
   Chromium(const Chromium&) = delete;
@@ -366,7 +375,7 @@ class Chromium {
     for (size_t done = 0; done < text.size();) {
       const ssize_t w = ::write(write_fd_, text.data() + done, text.size() - done);
       if (w < 0 && errno == EINTR) continue;
-      if (w <= 0) throw std::runtime_error("chromium closed its DevTools pipe (see " + (work_dir_ / "chromium.log").string() + ")");
+      if (w <= 0) throw std::runtime_error("chromium closed its DevTools pipe" + log_tail());
       done += static_cast<size_t>(w);
     }
     const auto deadline = std::chrono::steady_clock::now() +
@@ -399,7 +408,7 @@ class Chromium {
         return json::parse(text);
       }
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
-      if (left <= 0) throw std::runtime_error("chromium: no answer to " + waiting_for + " in time");
+      if (left <= 0) throw std::runtime_error("chromium: no answer to " + waiting_for + " in time" + log_tail());
       pollfd p{read_fd_, POLLIN, 0};
       const int ready = ::poll(&p, 1, static_cast<int>(std::min<long long>(left, 1000)));
       if (ready < 0 && errno == EINTR) continue;
@@ -407,9 +416,15 @@ class Chromium {
       char chunk[65536];
       const ssize_t r = ::read(read_fd_, chunk, sizeof chunk);
       if (r < 0 && errno == EINTR) continue;
-      if (r <= 0) throw std::runtime_error("chromium closed its DevTools pipe (see " + (work_dir_ / "chromium.log").string() + ")");
+      if (r <= 0) throw std::runtime_error("chromium closed its DevTools pipe" + log_tail());
       buffer_.append(chunk, static_cast<size_t>(r));
     }
+  }
+
+  // The end of the browser's own log, for a failure message (the log goes with the work directory).
+  std::string log_tail() const {
+    const std::string log = read_text(work_dir_ / "chromium.log");
+    return "; the end of its log:\n" + (log.size() > 3000 ? log.substr(log.size() - 3000) : log);
   }
 
   void note_event(const json& e) {
