@@ -117,6 +117,15 @@ class DartSimulator : public FixedStepSimulator {
   SettingsList settings() const override;
   std::vector<std::string> notes() const override { return notes_; }
   MassReadback mass_properties() const override;
+  // World::step alone: the contact parameters written once, then no lock, no parameters and no
+  // contact read per step (single-threaded benchmarks only: another world could change them).
+  void library_steps(long long n) override {
+    {
+      std::lock_guard<std::mutex> lock(kDartGlobalsMutex);
+      write_contact_parameters();
+    }
+    for (long long i = 0; i < n; ++i) world_->step(true);
+  }
 
  protected:
   void engine_step() override;
@@ -129,6 +138,7 @@ class DartSimulator : public FixedStepSimulator {
  private:
   void read_contacts();
   void make_notes();
+  void write_contact_parameters() const;
 
   DartSettings settings_;
   std::vector<std::string> notes_;
@@ -271,14 +281,19 @@ void DartSimulator::make_notes() {
   if (!full_sphere_note().empty()) notes_.push_back(full_sphere_note());
 }
 
+// DART's process-wide ContactConstraint parameters, this simulator's values (under the lock).
+void DartSimulator::write_contact_parameters() const {
+  using dart::constraint::ContactConstraint;
+  ContactConstraint::setErrorReductionParameter(settings_.erp);
+  ContactConstraint::setMaxErrorReductionVelocity(settings_.max_erv);
+  ContactConstraint::setErrorAllowance(settings_.error_allowance);
+  ContactConstraint::setConstraintForceMixing(settings_.cfm);
+}
+
 void DartSimulator::engine_step() {
   {
     std::lock_guard<std::mutex> lock(kDartGlobalsMutex);
-    using dart::constraint::ContactConstraint;
-    ContactConstraint::setErrorReductionParameter(settings_.erp);
-    ContactConstraint::setMaxErrorReductionVelocity(settings_.max_erv);
-    ContactConstraint::setErrorAllowance(settings_.error_allowance);
-    ContactConstraint::setConstraintForceMixing(settings_.cfm);
+    write_contact_parameters();
     // resetCommand = true clears the external forces the bench added for this step.
     world_->step(true);
   }
@@ -316,9 +331,11 @@ BodyState DartSimulator::engine_state() const {
   const Eigen::Isometry3d& T = body_->getWorldTransform();
   x.p_WG = T.translation();
   x.q_WB = Quat(T.linear()).normalized();
-  // The body origin is G: its classical linear velocity is v_G.
-  x.v_WG = body_->getLinearVelocity();
-  x.w_B = x.q_WB.conjugate() * body_->getAngularVelocity();
+  // The body origin is G: its classical linear velocity is v_G. One call for both halves:
+  // getLinearVelocity() and getAngularVelocity() each compute this 6-vector and keep half.
+  const Eigen::Vector6d V_W = body_->getSpatialVelocity(dart::dynamics::Frame::World(), dart::dynamics::Frame::World());
+  x.v_WG = V_W.tail<3>();
+  x.w_B = x.q_WB.conjugate() * Vec3(V_W.head<3>());
   return x;
 }
 

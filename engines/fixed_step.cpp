@@ -118,7 +118,9 @@ void FixedStepSimulator::advance_to(double t) {
 }
 
 void FixedStepSimulator::step_once() {
-  const BodyState x = engine_state();
+  // The state the last step ended in, as the per-step checks read it (start and set_state set it
+  // too): the engine's state is read once per step, not again here.
+  const BodyState& x = last_.state;
   if (scene_.contact.friction == FrictionLaw::Viscous) {
     // The source's law F_t = -k v_C at every contact the engine has, each at its own geometric
     // contact point with its own velocity (the engine's own contact is frictionless in this

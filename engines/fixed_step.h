@@ -45,6 +45,9 @@ class FixedStepSimulator : public Simulator {
   void bare_steps(long long n) {
     for (long long i = 0; i < n; ++i) engine_step();
   }
+  // Benchmarks only: n steps of the engine library's own step call alone, for an adapter whose
+  // engine_step does more than that (locks, process-wide parameters, the contact read).
+  virtual void library_steps(long long n) { bare_steps(n); }
 
  protected:
   explicit FixedStepSimulator(const Scene& scene);

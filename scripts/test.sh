@@ -4,4 +4,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
 cd build
-ctest --output-on-failure -j"$(nproc)" --timeout 900
+# The JUnit file tells .ci/run which tests ran and passed (ctest -N rewrites LastTest.log).
+ctest --output-on-failure -j"$(nproc)" --timeout 900 --output-junit ctest-junit.xml

@@ -416,7 +416,14 @@ class Interpreter : public TomlReader {
       validate_engine_settings(s);
       if (reference_engine().adopt) reference_engine().adopt(s);
     } catch (const std::invalid_argument& e) {
-      throw SceneError(file() + ": " + e.what());
+      // The shipped scenes give the reference's settings in [engines.analytic], so an override
+      // in the older spelling (--set run.rtol=...) meets them there: say which spelling to use.
+      std::string hint;
+      const std::string table = "engines." + reference_engine().name + ".";
+      for (const std::string& k : s.run.alias_keys)
+        if (overridden("run." + k) && std::string(e.what()).rfind(table + k + ":", 0) == 0)
+          hint = "; run." + k + " was set with --set: set " + table + k + " instead";
+      throw SceneError(file() + ": " + e.what() + hint);
     }
   }
 

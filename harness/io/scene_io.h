@@ -39,7 +39,8 @@ class SceneError : public std::runtime_error {
 //    (one line), contact.drilling (0), contact.stem (true), contact.flight (false),
 //    initial.velocity (not given), initial.position ([0, 0], G's x and y),
 //    initial.omega_along_contact (false), initial.height (0, >= 0), notes (one line each),
-//    run.rtol (1e-10, in [1e-15, 1e-2]), run.atol (1e-12, in (0, 1]).
+//    run.rtol (1e-10, in [1e-15, 1e-2]), run.atol (1e-12, in (0, 1]): the older spelling of
+//    [engines.analytic] rtol and atol (method and self_check too), where the shipped scenes give them.
 //  - mass: either density (> 0) and mass_model ("solid" | "seed"), both required, then
 //    compute_mass_properties(body); or all four of mass, com_offset, inertia_transverse,
 //    inertia_axial (MassModel::Given; density and mass_model must then be absent), with

@@ -115,8 +115,10 @@ struct SweepPlan {
 //    (values a non-empty array of distinct values: all finite numbers, all strings that pass
 //    is_valid_name, or all booleans), grid = {key, values} (optional, the same rules; its key
 //    other than the ladder's). A setup may only touch its engine's settings (engines.ENGINE.*)
-//    or, for the analytic model, run.rtol, run.atol and run.method: a sweep never changes the
-//    physics. Neither axis' key may also be in `set`. Instead of values, the ladder may be a
+//    or, for the analytic model, engines.analytic.rtol/atol/method (their older spelling
+//    run.rtol/atol/method is refused on a scene that gives them in [engines.analytic], as every
+//    shipped scene does): a sweep never changes the physics. Neither axis' key may also be in
+//    `set`. Instead of values, the ladder may be a
 //    boundary search, ladder.search = {key, from, to, criterion, resolution, per_decade}
 //    (read_search, sweep_search.h). scenes (optional): names of the sweep's scenes the setup runs
 //    on, each once (default: every scene).

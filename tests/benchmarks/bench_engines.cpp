@@ -39,14 +39,30 @@ void BM_BareSteps(benchmark::State& state, const std::string& engine) {
   state.SetItemsProcessed(state.iterations() * kSteps);
 }
 
+// The engine library's step call alone (DART: World::step without the adapter's lock, its
+// process-wide contact parameters and its contact read); the same as bare for the other engines.
+void BM_LibrarySteps(benchmark::State& state, const std::string& engine) {
+  const Scene scene = toy();
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto sim = make_simulator(engine, scene);
+    auto* fixed = dynamic_cast<FixedStepSimulator*>(sim.get());
+    state.ResumeTiming();
+    fixed->library_steps(kSteps);
+    benchmark::DoNotOptimize(sim.get());
+  }
+  state.SetItemsProcessed(state.iterations() * kSteps);
+}
+
 }  // namespace tippe
 
-// Both benchmarks for every registered engine (engines/registry.h): a new engine is measured
+// The three benchmarks for every registered engine (engines/registry.h): a new engine is measured
 // without an edit here.
 int main(int argc, char** argv) {
   for (const std::string& e : tippe::engine_names()) {
     benchmark::RegisterBenchmark(("BM_AdapterSteps/" + e).c_str(), tippe::BM_AdapterSteps, e)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("BM_BareSteps/" + e).c_str(), tippe::BM_BareSteps, e)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_LibrarySteps/" + e).c_str(), tippe::BM_LibrarySteps, e)->Unit(benchmark::kMillisecond);
   }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

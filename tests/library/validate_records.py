@@ -17,7 +17,7 @@ scenes = [ {{ file = {scene}, duration = 0.3 }} ]
 [[setup]]
 name = "reference"
 engine = "analytic"
-ladder.key = "run.rtol"
+ladder.key = "engines.analytic.rtol"
 ladder.values = [1e-6, 1e-8]
 [[setup]]
 name = "ode"

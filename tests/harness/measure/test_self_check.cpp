@@ -172,7 +172,7 @@ TEST(SelfCheck, CatchesAReferenceNotConvergedAndCutsTheMetricsAndTheReport) {
   // are not fixed by the motion, and at this tolerance the two methods part before that.
   TempDir dir{"tippe-self-check"};
   const Scene scene =
-      load_scene(kScenes + "source_dimensionless.toml", {"run.duration=23", "run.rtol=1e-8", "run.atol=1e-10"});
+      load_scene(kScenes + "source_dimensionless.toml", {"run.duration=23", "engines.analytic.rtol=1e-8", "engines.analytic.atol=1e-10"});
   CompareOptions o = quiet({"analytic", "ode"});
   o.out_dir = (dir.path() / "out").string();
   const Comparison c = run_comparison(scene, o);
@@ -212,7 +212,7 @@ TEST(SelfCheck, CatchesAReferenceNotConvergedAndCutsTheMetricsAndTheReport) {
 }
 
 TEST(SelfCheck, CatchesALooseToleranceOnTheToy) {
-  const Scene scene = load_scene(kScenes + "toy.toml", {"run.duration=2", "run.rtol=1e-3", "run.atol=1e-5"});
+  const Scene scene = load_scene(kScenes + "toy.toml", {"run.duration=2", "engines.analytic.rtol=1e-3", "engines.analytic.atol=1e-5"});
   const Comparison c = run_comparison(scene, quiet({"analytic"}));
   ASSERT_TRUE(c.self_check);
   ASSERT_TRUE(c.self_check->converged_until);
@@ -221,7 +221,7 @@ TEST(SelfCheck, CatchesALooseToleranceOnTheToy) {
 }
 
 TEST(SelfCheck, TurnedOffRecordsNone) {
-  const Scene scene = load_scene(kScenes + "source_dimensionless.toml", {"run.duration=1", "run.self_check=false"});
+  const Scene scene = load_scene(kScenes + "source_dimensionless.toml", {"run.duration=1", "engines.analytic.self_check=false"});
   EXPECT_FALSE(scene.run.self_check);
   const Comparison c = run_comparison(scene, quiet({"analytic"}));
   EXPECT_FALSE(c.self_check);

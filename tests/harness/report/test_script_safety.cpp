@@ -142,7 +142,7 @@ TEST(ScriptSafety, SweepRecordsWithAHostileNameAreRefused) {
   const std::string sweep = dir.write("tiny.toml", "repeats = 1\nscenes = [ { file = \"" + kSource +
                                                        "/harness/scenes/toy.toml\", duration = 0.02 } ]\n"
                                                        "[[setup]]\nname = \"analytic\"\nengine = \"analytic\"\n"
-                                                       "ladder.key = \"run.rtol\"\nladder.values = [1e-4, 1e-6]\n");
+                                                       "ladder.key = \"engines.analytic.rtol\"\nladder.values = [1e-4, 1e-6]\n");
   const fs::path out = dir.path() / "sweep";
   Outcome r = run_tippe({"sweep", sweep, "--out", out.string(), "--jobs", "1"}, dir.path());
   ASSERT_EQ(r.exit.code, 0) << r.err;

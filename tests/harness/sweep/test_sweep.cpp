@@ -442,7 +442,7 @@ TEST(SweepFiles, ShippedSweepsLoad) {
   for (const SweepSetup& s : def.spec.setups) {
     engines.insert(s.engine);
     if (s.ladder_key.find("timestep") != std::string::npos) most_steps = std::max(most_steps, s.ladder_values.size());
-    analytic_ladder = analytic_ladder || (s.engine == "analytic" && s.ladder_key == "run.rtol");
+    analytic_ladder = analytic_ladder || (s.engine == "analytic" && s.ladder_key == "engines.analytic.rtol");
   }
   for (const Scene& s : def.scenes) scenes.insert(s.name);
   EXPECT_GE(engines.size(), 4u) << "three engines and the analytic model";
