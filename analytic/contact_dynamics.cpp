@@ -217,7 +217,8 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
     }
     if (c_.drilling > 0.0 && !slot.drill_stick && !coupled_sliding) {
       const double spin_z = w_W.z();
-      drill_coeff = spin_z > 0 ? -c_.drilling : (spin_z < 0 ? c_.drilling : 0.0);
+      const double sign = slot.drill_dir != 0.0 ? slot.drill_dir : (spin_z > 0 ? 1.0 : (spin_z < 0 ? -1.0 : 0.0));
+      drill_coeff = -c_.drilling * sign;
     }
     idx[s].normal = n;
     idx[s].normal_dir = fdir;

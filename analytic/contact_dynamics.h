@@ -31,6 +31,13 @@ struct ContactSlot {
   // (the slip passing through 0, where both fields meet).
   bool graze = false;
   Vec3 slip_dir_W = Vec3::UnitX();  // Coulomb sliding direction used while |v_C| is ~0
+  // Decoupled drilling law only: the sign of the spin about the vertical that the sliding
+  // drilling torque opposes (+1 or -1; 0: the sign of the spin itself). Kept through a zero of
+  // the spin within a step, as slip_dir_W is, so that the integrator never steps over the jump
+  // of sign(w_z): on Bulirsch-Stoer that jump inside a step made the step's dense output miss
+  // its own starting state by 3.5e-2 rad/s in w_z, and the spin restarted there (leine_glocker_drilling
+  // at mu = 0.002: E rose by 3.5e-8 E0 at the drill_stick event).
+  double drill_dir = 0.0;
   // Coupled drilling law only: the sliding direction in the generalised slip space
   // (mu v_x, mu v_y, mu_d w_z) (lab axes), a unit vector, used while that slip is ~0 (as
   // slip_dir_W). `stick` and `drill_stick` are then set together: the law sticks only as a whole.

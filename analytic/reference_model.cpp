@@ -216,11 +216,20 @@ struct ReferenceModel::Impl {
   // (ContactSlot::coupled_floor): 1e-3 of the stick threshold, far above the round-off of a
   // slip zeroed at a restart and far below any slip the motion resolves.
   double coupled_floor = 0.0;
-  // Coupled law, per slot: a contact that has just left stick starts from exactly zero slip
-  // (project() zeroes the drift of the stuck integration), so that it starts sliding in the
-  // direction the stuck forces give (coupled_slide_dir), not in that of the drift.
-  std::array<bool, 2> zero_coupled_slip{false, false};
-  std::array<bool, 2> fresh_coupled_slip{false, false};  // ... and its SlipReversal starts positive (restart)
+  // Coulomb law (either drilling law), per slot: a contact that has just left stick starts from
+  // exactly zero slip (project() zeroes the drift of the stuck integration), so that it starts
+  // sliding in the direction the stuck forces give (slip_dir_W, coupled_slide_dir), not in that
+  // of the drift. A drift against that direction is otherwise a self-consistent wrong branch of
+  // the continued law: the reference flips the force to its own side, so the force drives the
+  // slip and the friction work falls without bound (measured on leine_glocker at mu = 0.02,
+  // tilt 1 rad: E rose to 3.4 E0 in 14 s after the slip start at 7.537 s, the ledger closed).
+  std::array<bool, 2> zero_slip{false, false};
+  std::array<bool, 2> fresh_slip{false, false};  // ... and its SlipReversal starts positive (restart)
+  // The same for the decoupled drilling torque: a spin about the vertical that leaves drilling
+  // stick starts from exactly zero (project() zeroes its drift) with the sign the stuck torque
+  // gives, and its DrillReversal starts positive.
+  std::array<bool, 2> zero_drill{false, false};
+  std::array<bool, 2> fresh_drill{false, false};
   double dt_hint = 0.0;
   std::string failure_hint;  // appended to a "non-finite state" failure: what to try instead
   long long events_in_burst = 0;
@@ -284,7 +293,11 @@ struct ReferenceModel::Impl {
       mode.slot[s].slip_dir_W = ref_dir[s];
     }
     const double wz = (unpack(y, 0).q_WB.normalized() * unpack(y, 0).w_B).z();
-    drill_ref_sign = wz >= 0 ? 1.0 : -1.0;
+    // The decoupled drilling torque's sign is continued through a zero of w_z (ContactSlot::
+    // drill_dir); exactly 0 is a spin zeroed at a drilling slip start, which keeps its sign.
+    const double kept = mode.slot[0].drill_dir != 0.0 ? mode.slot[0].drill_dir : 1.0;
+    drill_ref_sign = wz > 0 ? 1.0 : (wz < 0 ? -1.0 : kept);
+    for (int s = 0; s < 2; ++s) mode.slot[s].drill_dir = drill_ref_sign;
     if (dyn.coupled())
       for (int s = 0; s < 2; ++s) {
         const Vec3 u = coupled_slip(f, wz, s);
@@ -465,14 +478,15 @@ struct ReferenceModel::Impl {
     build_event_functions();
     refresh_references(y);
     g_start = g_all(y);
-    // A coupled contact that starts to slide from zero slip starts on the positive side of its
+    // A contact that starts to slide from zero slip starts on the positive side of its
     // SlipReversal function (0 there): the continuation's flip of the direction makes a slip
     // that grows against the reference a self-consistent motion in which the force drives the
     // slip; a crossing from exactly 0 would not be bracketed, so it is counted as one.
     for (size_t i = 0; i < fns.size(); ++i)
-      if (fns[i].kind == EvKind::SlipReversal && dyn.coupled() && fresh_coupled_slip[fns[i].slot] && !(g_start[i] > 0))
-        g_start[i] = std::numeric_limits<double>::denorm_min();
-    fresh_coupled_slip = {false, false};
+      if ((fns[i].kind == EvKind::SlipReversal && fresh_slip[fns[i].slot]) ||
+          (fns[i].kind == EvKind::DrillReversal && fresh_drill[fns[i].slot]))
+        if (!(g_start[i] > 0)) g_start[i] = std::numeric_limits<double>::denorm_min();
+    fresh_slip = fresh_drill = {false, false};
     track_graze(graze_last);
     pending = false;
     ledger_t = t;
@@ -616,6 +630,7 @@ struct ReferenceModel::Impl {
       slot.active = candidates[s];
       slot.slip_dir_W = prev.slot[s].slip_dir_W;
       slot.drill_stick = prev.slot[s].active && prev.slot[s].drill_stick;
+      slot.drill_dir = prev.slot[s].drill_dir;
       slot.graze = false;
       slot.coupled_dir = prev.slot[s].coupled_dir;
       slot.coupled_floor = coupled_floor;
@@ -652,7 +667,7 @@ struct ReferenceModel::Impl {
           if (slot.stick && dyn.coupled_demand(f, s) > f.normal[s]) {
             slot.stick = slot.drill_stick = false;
             slot.coupled_dir = coupled_slide_dir(f, s);
-            zero_coupled_slip[s] = true;  // it starts to slide from (near) zero slip, see handle()
+            zero_slip[s] = true;  // it starts to slide from (near) zero slip, see handle()
             changed = true;
           }
           continue;
@@ -662,11 +677,14 @@ struct ReferenceModel::Impl {
           if (ft.norm() > c.mu * f.normal[s]) {
             slot.stick = false;
             slot.slip_dir_W = -ft.normalized();
+            zero_slip[s] = true;  // as under the coupled law
             changed = true;
           }
         }
         if (slot.drill_stick && std::abs(f.drill_torque[s]) > c.drilling * f.normal[s]) {
           slot.drill_stick = false;
+          m.slot[0].drill_dir = m.slot[1].drill_dir = f.drill_torque[s] > 0 ? -1.0 : 1.0;  // the spin starts against the torque
+          zero_drill[s] = true;
           changed = true;
         }
       }
@@ -697,10 +715,10 @@ struct ReferenceModel::Impl {
         x.w_B = x.q_WB.conjugate() * w_W;
       }
     }
-    if (dyn.coupled())
-      for (int k = 0; k < 2; ++k)
-        if (mode.slot[k].active && (mode.slot[k].stick || zero_coupled_slip[k])) {
-          // The coupled law sticks as a whole: the spin about the vertical is held at zero too.
+    for (int k = 0; k < 2; ++k)
+        if (mode.slot[k].active && ((dyn.coupled() && (mode.slot[k].stick || zero_slip[k])) || zero_drill[k])) {
+          // The coupled law sticks as a whole: the spin about the vertical is held at zero too;
+          // a decoupled drilling slip starts from zero spin.
           Vec3 w_W = x.q_WB * x.w_B;
           w_W.z() = 0.0;
           x.w_B = x.q_WB.conjugate() * w_W;
@@ -720,7 +738,7 @@ struct ReferenceModel::Impl {
         x.w_B = held.w_B;
       } else {
         x.v_WG.z() = -w_W.cross(geo.r_GO_W).z();
-        if (mode.slot[s].stick || (dyn.coupled() && zero_coupled_slip[s])) {
+        if (mode.slot[s].stick || zero_slip[s]) {
           Vec3 slip = dyn.contact_velocity(x, s);
           slip.z() = 0;
           x.v_WG -= slip;
@@ -729,8 +747,11 @@ struct ReferenceModel::Impl {
     } else if (positioned) {
       *positioned = pack(x);
     }
-    for (int k = 0; k < 2; ++k) fresh_coupled_slip[k] = fresh_coupled_slip[k] || zero_coupled_slip[k];
-    zero_coupled_slip = {false, false};
+    for (int k = 0; k < 2; ++k) {
+      fresh_slip[k] = fresh_slip[k] || zero_slip[k];
+      fresh_drill[k] = fresh_drill[k] || zero_drill[k];
+    }
+    zero_slip = zero_drill = {false, false};
     return pack(x);
   }
 
@@ -841,14 +862,18 @@ struct ReferenceModel::Impl {
               next.slot[s].coupled_dir = u.normalized();
             } else {
               next.slot[s].coupled_dir = coupled_slide_dir(f, s);
-              zero_coupled_slip[s] = true;
+              zero_slip[s] = true;
             }
           }
           break;
         }
         Vec3 v = dyn.contact_velocity(x, s);
         v.z() = 0;
-        if (v.norm() <= slip_eps) {
+        if (v.norm() > slip_eps) {
+          // Not a zero: the slip turned by more than 90 deg from the reference within a step
+          // (as under the coupled law above); the force follows the slip's own direction.
+          next.slot[s].slip_dir_W = v.normalized();
+        } else {
           ContactMode trial = next;
           trial.slot[s].stick = true;
           const ContactForces f = forces_at(y, trial);
@@ -856,8 +881,14 @@ struct ReferenceModel::Impl {
           if (ft.norm() <= c.mu * f.normal[s]) {
             next = trial;
             owner.events_.push_back({"stick", te, std::string("slip vanishes on the ") + slot_name(s), ft.norm() / f.normal[s]});
+          } else if (v.norm() > 1e-3 * slip_eps) {
+            // A slip that has begun to grow against the reference (just after a slip start):
+            // the force follows the slip's own direction from here. 1e-3 slip_eps: the
+            // coupled law's floor (coupled_floor), far above a zeroed slip's round-off.
+            next.slot[s].slip_dir_W = v.normalized();
           } else {
             next.slot[s].slip_dir_W = -ft.normalized();
+            zero_slip[s] = true;
           }
         }
         break;
@@ -867,13 +898,14 @@ struct ReferenceModel::Impl {
         if (dyn.coupled()) {
           next.slot[s].stick = next.slot[s].drill_stick = false;
           next.slot[s].coupled_dir = coupled_slide_dir(f, s);
-          zero_coupled_slip[s] = true;
+          zero_slip[s] = true;
           owner.events_.push_back({"slip", te, std::string("friction and drilling torque leave the ellipse on the ") + slot_name(s) + " (coupled law)", 0.0});
           break;
         }
         const Vec3 ft(f.force_W[s].x(), f.force_W[s].y(), 0.0);
         next.slot[s].stick = false;
         next.slot[s].slip_dir_W = ft.norm() > 0 ? Vec3(-ft.normalized()) : ref_dir[s];
+        zero_slip[s] = true;
         owner.events_.push_back({"slip", te, std::string("friction leaves the cone on the ") + slot_name(s), 0.0});
         break;
       }
@@ -881,9 +913,17 @@ struct ReferenceModel::Impl {
         ContactMode trial = next;
         trial.slot[s].drill_stick = true;
         const ContactForces f = forces_at(y, trial);
-        if (std::abs(f.drill_torque[s]) <= c.drilling * f.normal[s]) {
+        const double wz = (x.q_WB.normalized() * x.w_B).z();
+        if (std::abs(wz) * b.R > slip_eps) {
+          // Not a zero (a spin that turned within a step): the torque opposes the spin's own sign.
+          next.slot[0].drill_dir = next.slot[1].drill_dir = wz > 0 ? 1.0 : -1.0;
+        } else if (std::abs(f.drill_torque[s]) <= c.drilling * f.normal[s]) {
           next = trial;
           owner.events_.push_back({"drill_stick", te, std::string("spin about the vertical stops on the ") + slot_name(s), 0.0});
+        } else {
+          // The spin passes through zero: it starts again against the torque that sticking needs.
+          next.slot[0].drill_dir = next.slot[1].drill_dir = f.drill_torque[s] > 0 ? -1.0 : 1.0;
+          zero_drill[s] = true;
         }
         break;
       }
@@ -903,10 +943,15 @@ struct ReferenceModel::Impl {
         next.slot[s].active = false;
         owner.events_.push_back({"lift", te, std::string("the ") + slot_name(s) + " leaves the floor: the viscous force has lost its leverage on the gap", 0.0});
         break;
-      case EvKind::DrillConeExit:
+      case EvKind::DrillConeExit: {
+        const ContactForces f = forces_at(y, mode);
         next.slot[s].drill_stick = false;
+        next.slot[s].drill_dir = f.drill_torque[s] > 0 ? -1.0 : 1.0;  // the spin starts against the torque
+        next.slot[1 - s].drill_dir = next.slot[s].drill_dir;  // one spin about the vertical
+        zero_drill[s] = true;
         owner.events_.push_back({"drill_slip", te, "drilling torque leaves its bound", 0.0});
         break;
+      }
       case EvKind::Touchdown: {
         std::array<bool, 2> touching{mode.slot[0].active || s == 0, mode.slot[1].active || s == 1};
         std::array<double, 2> impulse{0, 0};

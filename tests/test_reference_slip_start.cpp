@@ -1,0 +1,158 @@
+// The decoupled Coulomb law through stick -> slip starts, drilling stick and cascade holds: the energy ledger closes and friction never adds energy.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "../analytic/initial_state.h"
+#include "../analytic/reference_model.h"
+#include "scene_io.h"
+
+namespace tippe {
+namespace {
+
+Scene shipped(const std::string& name) { return load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/" + name + ".toml"); }
+
+struct Ledger {
+  double worst = 0.0;          // largest |E + ledger - E0| / E0
+  double worst_drop = 0.0;     // largest fall of the friction work between samples, / E0
+  double worst_rise = 0.0;     // largest rise of E between samples, / E0
+  double e_max = 0.0;          // largest E / E0
+  std::vector<ReferenceEvent> events;
+  ReferenceStatus status = ReferenceStatus::Ok;
+  std::string detail;
+};
+
+// Samples every sample interval and just before and after every event of a first run (E and the
+// ledger jump together at an impact), as the harness runs the reference (sample by sample).
+Ledger run_ledger(const Scene& s) {
+  std::vector<double> times;
+  {
+    ReferenceModel first(s);
+    for (double t = s.run.sample_interval; t < s.run.duration && first.status() == ReferenceStatus::Ok; t += s.run.sample_interval)
+      first.advance_to(t);
+    for (const auto& e : first.events()) {
+      times.push_back(e.time - 1e-9);
+      times.push_back(e.time + 1e-9);
+    }
+  }
+  for (double t = s.run.sample_interval; t < s.run.duration; t += s.run.sample_interval) times.push_back(t);
+  times.push_back(s.run.duration);
+  std::sort(times.begin(), times.end());
+  ReferenceModel m(s);
+  const BodyModel& b = m.body();
+  const double e0 = energy(b, scene_initial_state(s));
+  Ledger out;
+  double w_prev = 0.0, e_prev = 1.0;
+  for (double t : times) {
+    if (m.status() != ReferenceStatus::Ok || t > s.run.duration || t <= 0) continue;
+    m.advance_to(t);
+    if (m.status() != ReferenceStatus::Ok) break;
+    const double e = energy(b, m.state()) / e0, w = m.energy_ledger().friction / e0;
+    out.worst = std::max(out.worst, std::abs(e + m.energy_ledger().total() / e0 - 1.0));
+    out.worst_drop = std::max(out.worst_drop, w_prev - w);
+    out.worst_rise = std::max(out.worst_rise, e - e_prev);
+    out.e_max = std::max(out.e_max, e);
+    w_prev = w;
+    e_prev = e;
+  }
+  out.events = m.events();
+  out.status = m.status();
+  out.detail = m.status_detail();
+  return out;
+}
+
+int count(const std::vector<ReferenceEvent>& events, const std::string& name) {
+  return static_cast<int>(std::count_if(events.begin(), events.end(), [&](const ReferenceEvent& e) { return e.name == name; }));
+}
+
+// The Leine-Glocker top at mu = 0.02 from a tilt of 1 rad sticks and slips again three times
+// (7.44 s to 14.6 s). Before the slip start zeroed the stuck drift, the drift of the third slip
+// start lay against the stuck forces' direction: the continued law flipped the force to the
+// drift's side, the force drove the slip, and E rose to 3.4 E0 by 21.9 s (friction work -2.40 E0,
+// the ledger closing all along), where the floor let go. Bounds: the ledger to 1e-9 E0 as the
+// other ledger tests ask (rtol 1e-10 over ~30 s and a few events); the friction work may fall
+// only by the work of a stuck contact's force on its tolerance-sized drift, either sign
+// (measured 3e-13 E0), bounded by 1e-10 E0 (rtol times E0); E may rise between samples only
+// by the tolerance-sized drift corrections at restarts, likewise 1e-9 E0.
+TEST(ReferenceSlipStart, DecoupledSlipStartNeverDrivesTheSlip) {
+  Scene s = shipped("leine_glocker");
+  s.contact.mu = 0.02;
+  s.initial.tilt = 1.0;
+  const Ledger l = run_ledger(s);
+  std::printf("leine_glocker mu 0.02 tilt 1: %d slip starts, ledger %.3g E0, friction work drop %.3g E0, E rise %.3g E0, max E %.6f E0\n",
+              count(l.events, "slip"), l.worst, l.worst_drop, l.worst_rise, l.e_max);
+  ASSERT_EQ(l.status, ReferenceStatus::Ok) << l.detail;
+  EXPECT_GE(count(l.events, "slip"), 3);
+  EXPECT_LT(l.worst, 1e-9);
+  EXPECT_LT(l.worst_drop, 1e-10);
+  EXPECT_LT(l.worst_rise, 1e-9);
+  EXPECT_LE(l.e_max, 1.0 + 1e-9);
+}
+
+// The decoupled drilling torque -mu_d F_n sign(w_z) jumps where the spin about the vertical
+// passes 0. Without a continuation through that zero the jump fell inside a Bulirsch-Stoer
+// step, whose dense output then missed its own starting state by 3.5e-2 rad/s in w_z; the
+// spin restarted there at the drill_stick event and E rose by 3.5e-8 E0 (7.4e-7 E0 before the
+// slip start's fix). Leine-Glocker top with mu_d = 1e-4 m at mu = 0.002: stick, slip start
+// (18.65 s), drilling stick (21.23 s), stick. Bounds as above.
+TEST(ReferenceSlipStart, DecoupledDrillingStickWithoutEnergyGain) {
+  Scene s = shipped("leine_glocker_drilling");
+  s.contact.mu = 0.002;
+  const Ledger l = run_ledger(s);
+  std::printf("leine_glocker_drilling mu 0.002: ledger %.3g E0, friction work drop %.3g E0, E rise %.3g E0\n", l.worst, l.worst_drop,
+              l.worst_rise);
+  ASSERT_EQ(l.status, ReferenceStatus::Ok) << l.detail;
+  EXPECT_EQ(count(l.events, "drill_stick"), 1);
+  EXPECT_GE(count(l.events, "slip"), 1);
+  EXPECT_LT(l.worst, 1e-9);
+  EXPECT_LT(l.worst_drop, 1e-10);
+  EXPECT_LT(l.worst_rise, 1e-9);
+}
+
+// A cascade closed by a hold under Coulomb friction (the shipped hold scenes are viscous, whose
+// impacts carry no friction impulse): tilt_near_pi with Coulomb mu = 0.2 (ball impact at
+// 0.3717 s held with the stem). The hold's projection removes energy only (value >= 0 to the
+// round-off of two energies), and the ledger closes across it.
+TEST(ReferenceSlipStart, CoulombHoldClosesTheLedger) {
+  Scene s = shipped("extremes/tilt_near_pi");
+  s.contact.friction = FrictionLaw::Coulomb;
+  s.contact.mu = 0.2;
+  const Ledger l = run_ledger(s);
+  const double e0 = energy(BodyModel::from_scene(s), scene_initial_state(s));
+  std::printf("tilt_near_pi coulomb 0.2: %d holds, %d impacts, ledger %.3g E0\n", count(l.events, "hold"), count(l.events, "impact"), l.worst);
+  ASSERT_EQ(l.status, ReferenceStatus::Ok) << l.detail;
+  EXPECT_GE(count(l.events, "hold"), 1);
+  EXPECT_LT(l.worst, 1e-9);
+  for (const auto& e : l.events)
+    if (e.name == "impact" || e.name == "hold" || e.name == "projection") {
+      EXPECT_GE(e.value, -4e-15 * e0) << e.name << " at " << e.time;
+    }
+}
+
+// Measured (Release): with dopri5 every decoupled slip start above stalls within 2 ms, the
+// energy balanced and not rising: "no progress" at 7.46335 s on the first test's top (last step
+// 5.7e-11 s), 18.64989 s on the second's (1.2e-10 s), 0.18267 s on the third's (1.0e-11 s);
+// rosenbrock4 at 7.46381 s (2.6e-9 s). The slip grows from zero (as c t^2, c = 6.7 m/s^3 on
+// the first top) while its direction relaxes at the rate mu F_n |W| / |v_C| (W the contact's
+// mobility), which has no bound as the slip starts: the explicit methods pin the slip at
+// ~1e-11 m/s with steps at their stability limit; Rosenbrock follows the slip but its
+// difference Jacobian perturbs v_G by more than the slip itself until ~1e-3 s after the start.
+// Bulirsch-Stoer's first long step passes over the phase. The same stall as the coupled
+// twin's (test_drilling_coupled.cpp). Not tuned: a documented case.
+TEST(ReferenceSlipStart, DISABLED_DecoupledSlipStartByDopri5) {
+  Scene s = shipped("leine_glocker");
+  s.contact.mu = 0.02;
+  s.initial.tilt = 1.0;
+  s.run.method = "dopri5";
+  s.run.duration = 15.0;
+  ReferenceModel m(s);
+  for (int k = 1; k <= 15000 && m.status() == ReferenceStatus::Ok; ++k) m.advance_to(1e-3 * k);
+  EXPECT_EQ(m.status(), ReferenceStatus::Ok) << m.status_detail();
+}
+
+}  // namespace
+}  // namespace tippe
