@@ -88,7 +88,12 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
       grazing = s;
       ++n_grazing;
     }
-  if (n_grazing == 0) return evaluate_fixed(y, mode, dydt, 1.0);
+  if (n_grazing == 0) {
+    for (int s = 0; s < 2; ++s)
+      if (c_.friction == FrictionLaw::Coulomb && mode.slot[s].active && !mode.slot[s].stick && mode.slot[s].slip_start)
+        return evaluate_slip_start(y, mode, dydt);
+    return evaluate_fixed(y, mode, dydt, 1.0);
+  }
   // Filippov's combination of the lifted (share 0) and the loaded (share 1) fields; both are
   // linear in the share, so the combination is the exact solution at the share found.
   StateVector d0, d1;
@@ -112,6 +117,85 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
   out.normal[s] = 0.0;
   if (dydt)
     for (size_t i = 0; i < d0.size(); ++i) (*dydt)[i] = (1 - f) * d0[i] + f * d1[i];
+  return out;
+}
+
+Vec3 ContactDynamics::slip_rate(const StateVector& y, const StateVector& dy, int s) const {
+  const BodyState x = unpack(y, 0);
+  const Quat q = x.q_WB.normalized();
+  const Vec3 w_W = q * x.w_B, wdot_W = q * Vec3(dy[10], dy[11], dy[12]);
+  const ContactGeometry geo = geometry(x, s);
+  // d/dt (v_G + w x r_GC), r_GC = r_GO - radius e_z with r_GO fixed in the body.
+  const Vec3 a = Vec3(dy[3], dy[4], dy[5]) + wdot_W.cross(geo.r_GC_W) + w_W.cross(w_W.cross(geo.r_GO_W));
+  if (coupled()) return Vec3(c_.mu * a.x(), c_.mu * a.y(), c_.drilling * wdot_W.z());
+  return Vec3(a.x(), a.y(), 0.0);
+}
+
+ContactForces ContactDynamics::evaluate_slip_start(const StateVector& y, const ContactMode& mode, StateVector* dydt) const {
+  // Newton on the unit sphere (the unit circle for the decoupled law) for G(n) = T (a(n) -
+  // (a(n) . n) n) = 0, T a basis of the plane normal to n and a(n) the rate of the
+  // generalised slip when the friction takes the direction n: the direction in which a slip
+  // started from zero grows (a = lambda n; the root with lambda >= 0 nearest the guess).
+  // The Jacobian by differences of 1e-7 rad (right to ~1e-7, so each iteration gains seven
+  // digits); iterations to an angle of 1e-14, so that the right-hand side is smooth in the
+  // state to round-off (the step control sees no noise from the solve).
+  ContactMode m = mode;
+  const bool three = coupled();
+  StateVector dy{};
+  for (int sweep = 0; sweep < 2; ++sweep)
+    for (int s = 0; s < 2; ++s) {
+      ContactSlot& slot = m.slot[s];
+      if (!slot.active || slot.stick || !slot.slip_start) continue;
+      Vec3& dir = three ? slot.coupled_dir : slot.slip_dir_W;
+      if (!three) dir.z() = 0.0;
+      dir.normalize();
+      auto rate = [&](const Vec3& n) {
+        dir = n;
+        StateVector d;
+        evaluate_fixed(y, m, &d, 1.0);
+        return slip_rate(y, d, s);
+      };
+      for (int iter = 0; iter < 30; ++iter) {
+        const Vec3 n = dir;
+        Vec3 t1 = three ? n.unitOrthogonal() : Vec3(-n.y(), n.x(), 0.0);
+        Vec3 t2 = n.cross(t1);
+        const int k = three ? 2 : 1;
+        const Vec3 basis[2] = {t1, t2};
+        auto G = [&](const Vec3& nn) {
+          const Vec3 a = rate(nn);
+          const Vec3 p = a - a.dot(nn) * nn;
+          return Eigen::Vector2d(basis[0].dot(p), basis[1].dot(p));
+        };
+        const Eigen::Vector2d g0 = G(n);
+        constexpr double h = 1e-7;
+        Eigen::Matrix2d J = Eigen::Matrix2d::Identity();
+        for (int j = 0; j < k; ++j) {
+          const Eigen::Vector2d gj = G((n + h * basis[j]).normalized());
+          J.col(j) = (gj - g0) / h;
+        }
+        Eigen::Vector2d delta = Eigen::Vector2d::Zero();
+        if (k == 1) {
+          delta(0) = J(0, 0) != 0.0 ? -g0(0) / J(0, 0) : 0.0;
+        } else {
+          delta = J.fullPivLu().solve(-g0);
+        }
+        // A step of at most 0.5 rad: Newton from a guess far from the root must not jump to
+        // the antipodal root (lambda < 0, the slip shrinking against its force).
+        const double len = delta.norm();
+        if (!std::isfinite(len)) break;
+        if (len > 0.5) delta *= 0.5 / len;
+        dir = (n + delta(0) * basis[0] + delta(1) * basis[1]).normalized();
+        if (len < 1e-14) break;
+      }
+    }
+  ContactForces out = evaluate_fixed(y, m, &dy, 1.0);
+  for (int s = 0; s < 2; ++s) {
+    const ContactSlot& slot = m.slot[s];
+    if (!slot.active || slot.stick || !slot.slip_start) continue;
+    out.start_dir[s] = three ? slot.coupled_dir : slot.slip_dir_W;
+    out.start_rate[s] = slip_rate(y, dy, s).dot(out.start_dir[s]);
+  }
+  if (dydt) *dydt = dy;
   return out;
 }
 
@@ -181,7 +265,7 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
       // direction below, so that the dense output stays smooth through a zero of u.
       const Vec3 u(c_.mu * slip.x(), c_.mu * slip.y(), c_.drilling * w_W.z());  // coupled_slip()
       const double S = u.norm();
-      Vec3 dir = S > slot.coupled_floor ? Vec3(u / S) : slot.coupled_dir;
+      Vec3 dir = S > slot.coupled_floor && !slot.slip_start ? Vec3(u / S) : slot.coupled_dir;
       if (dir.dot(slot.coupled_dir) < 0) dir = -dir;
       fdir -= c_.mu * Vec3(dir.x(), dir.y(), 0.0);
       drill_coeff = -c_.drilling * dir.z();
@@ -192,7 +276,7 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
       // integrator never steps over a kink and the "slip vanishes" event is located on a
       // smooth dense output. The reference is refreshed every step.
       const double speed = slip.norm();
-      Vec3 dir = speed > 0.0 ? Vec3(slip / speed) : slot.slip_dir_W;
+      Vec3 dir = speed > 0.0 && !slot.slip_start ? Vec3(slip / speed) : slot.slip_dir_W;
       if (dir.dot(slot.slip_dir_W) < 0) dir = -dir;
       fdir -= c_.mu * dir;
     }
@@ -318,6 +402,40 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
     d[10] = wdot_B.x(); d[11] = wdot_B.y(); d[12] = wdot_B.z();
   }
   return out;
+}
+
+BodyState ContactDynamics::stop_contact(const BodyState& x, int slot, bool spin) const {
+  const Quat q = x.q_WB.normalized();
+  const Eigen::Matrix3d R_WB = q.toRotationMatrix();
+  const Vec3 I_B(m_.A, m_.A, m_.C);
+  const Eigen::Matrix3d Iinv_W = R_WB * I_B.cwiseInverse().asDiagonal() * R_WB.transpose();
+  const Vec3 w_W = q * x.w_B;
+  const Vec3 r = geometry(x, slot).r_GC_W;
+  const Vec3 v_C = x.v_WG + w_W.cross(r);
+  const int n = spin ? 4 : 3;
+  // Unknowns: the impulse at C (x, y, z) and the angular impulse about e_z; rows: the velocity
+  // of C and w_z. K = J M^-1 J^T, symmetric positive definite.
+  Vec3 f[4], tau[4];
+  for (int j = 0; j < 3; ++j) {
+    f[j] = Vec3::Unit(j);
+    tau[j] = r.cross(f[j]);
+  }
+  f[3] = Vec3::Zero();
+  tau[3] = Vec3::UnitZ();
+  Eigen::Matrix4d K = Eigen::Matrix4d::Identity();
+  Eigen::Vector4d b(-v_C.x(), -v_C.y(), -v_C.z(), -w_W.z());
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) K(i, j) = f[i].dot(f[j]) / m_.M + tau[i].dot(Iinv_W * tau[j]);
+  const Eigen::VectorXd u = K.topLeftCorner(n, n).ldlt().solve(b.head(n));
+  Vec3 P = Vec3::Zero(), L = Vec3::Zero();
+  for (int j = 0; j < n; ++j) {
+    P += f[j] * u(j);
+    L += tau[j] * u(j);
+  }
+  BodyState post = x;
+  post.v_WG = x.v_WG + P / m_.M;
+  post.w_B = q.conjugate() * Vec3(w_W + Iinv_W * L);
+  return post;
 }
 
 BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touching, std::array<bool, 2>* kept,

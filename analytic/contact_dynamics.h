@@ -45,6 +45,14 @@ struct ContactSlot {
   // Coupled law: below this generalised slip |(mu v, mu_d w_z)| the direction is coupled_dir
   // (a slip zeroed at a restart is round-off, whose direction means nothing).
   double coupled_floor = 0.0;
+  // Coulomb law (either drilling law), sliding: the slip has just started from zero and is
+  // still below the reference's threshold. Its direction is then not the slip's own but the
+  // one in which the slip grows: the unit n (slip_dir_W, or coupled_dir under the coupled law)
+  // with d(slip)/dt = lambda n, lambda >= 0, solved at every evaluation (the slow manifold of
+  // the direction, whose own relaxation rate mu F_n |W| / |slip| has no bound as the slip
+  // starts; integrated as it is, that stiff phase stalled every method). slip_dir_W or
+  // coupled_dir is the starting guess of the solve.
+  bool slip_start = false;
 };
 
 struct ContactMode {
@@ -65,6 +73,12 @@ struct ContactForces {
   std::array<double, 2> graze_lifted_accel{0, 0};
   std::array<double, 2> graze_loaded_accel{0, 0};
   std::array<double, 2> graze_fraction_raw{1, 1};
+  // Slip-start contacts only (ContactSlot::slip_start): the direction n solved (lab x, y and,
+  // under the coupled law, the drilling component) and the slip's growth rate lambda along it
+  // (generalised slip units per second: m/s^2 for the decoupled law, those of coupled_slip()
+  // per second for the coupled one).
+  std::array<Vec3, 2> start_dir{Vec3::UnitX(), Vec3::UnitX()};
+  std::array<double, 2> start_rate{0, 0};
   bool solvable = true;
 };
 
@@ -105,6 +119,12 @@ class ContactDynamics {
   BodyState impact(const BodyState& x, std::array<bool, 2> touching, std::array<bool, 2>* kept,
                    std::array<double, 2>* normal_impulse, Impulses kind = Impulses::Impact) const;
 
+  // The state with the material point at the contact of `slot` at rest (and, with `spin`, the
+  // spin about the vertical stopped too), by the impulse (and angular impulse about the
+  // vertical) at the contact that does it with the smallest change of kinetic energy: a
+  // projection in the mass metric, so it can only remove energy (positions unchanged).
+  BodyState stop_contact(const BodyState& x, int slot, bool spin) const;
+
   // Acceleration of the centre of the contact sphere of `slot` along z, from a state derivative.
   double gap_acceleration(const StateVector& y, const StateVector& dydt, int slot) const;
 
@@ -124,6 +144,11 @@ class ContactDynamics {
   double coupled_demand(const ContactForces& f, int slot) const;
 
  private:
+  // evaluate() with the slip-start contacts' directions solved (ContactSlot::slip_start).
+  ContactForces evaluate_slip_start(const StateVector& y, const ContactMode& mode, StateVector* dydt) const;
+  // Rate of the generalised slip of slot s (lab x, y of the contact point's velocity, times mu
+  // under the coupled law, and mu_d dw_z/dt there) from a state derivative.
+  Vec3 slip_rate(const StateVector& y, const StateVector& dy, int s) const;
   // evaluate() with every grazing contact carrying the fixed share `share` of its viscous force.
   ContactForces evaluate_fixed(const StateVector& y, const ContactMode& mode, StateVector* dydt, double share) const;
   BodyModel m_;

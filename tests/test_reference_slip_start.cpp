@@ -77,20 +77,40 @@ int count(const std::vector<ReferenceEvent>& events, const std::string& name) {
 // other ledger tests ask (rtol 1e-10 over ~30 s and a few events); the friction work may fall
 // only by the work of a stuck contact's force on its tolerance-sized drift, either sign
 // (measured 3e-13 E0), bounded by 1e-10 E0 (rtol times E0); E may rise between samples only
-// by the tolerance-sized drift corrections at restarts, likewise 1e-9 E0.
+// by the tolerance-sized drift corrections at restarts, likewise 1e-9 E0. Both explicit
+// methods: before a starting slip's direction was solved (ContactSlot::slip_start) dopri5
+// stalled 6 ms after the first slip start ("no progress" at 7.46335 s, last step 5.7e-11 s).
+// Their events agree to 1e-6 s up to the inversion (measured 1.2e-9 s); the stick after it,
+// where the slip dies out slowly, is ill-conditioned (14.6405 s against 14.6411 s) and left out.
 TEST(ReferenceSlipStart, DecoupledSlipStartNeverDrivesTheSlip) {
-  Scene s = shipped("leine_glocker");
-  s.contact.mu = 0.02;
-  s.initial.tilt = 1.0;
-  const Ledger l = run_ledger(s);
-  std::printf("leine_glocker mu 0.02 tilt 1: %d slip starts, ledger %.3g E0, friction work drop %.3g E0, E rise %.3g E0, max E %.6f E0\n",
-              count(l.events, "slip"), l.worst, l.worst_drop, l.worst_rise, l.e_max);
-  ASSERT_EQ(l.status, ReferenceStatus::Ok) << l.detail;
-  EXPECT_GE(count(l.events, "slip"), 3);
-  EXPECT_LT(l.worst, 1e-9);
-  EXPECT_LT(l.worst_drop, 1e-10);
-  EXPECT_LT(l.worst_rise, 1e-9);
-  EXPECT_LE(l.e_max, 1.0 + 1e-9);
+  std::vector<ReferenceEvent> events[2];
+  int k = 0;
+  for (const char* method : {"bulirsch_stoer", "dopri5"}) {
+    Scene s = shipped("leine_glocker");
+    s.contact.mu = 0.02;
+    s.initial.tilt = 1.0;
+    s.run.method = method;
+    const Ledger l = run_ledger(s);
+    std::printf("leine_glocker mu 0.02 tilt 1, %s: %d slip starts, ledger %.3g E0, friction work drop %.3g E0, E rise %.3g E0, max E %.6f E0\n",
+                method, count(l.events, "slip"), l.worst, l.worst_drop, l.worst_rise, l.e_max);
+    ASSERT_EQ(l.status, ReferenceStatus::Ok) << method << ": " << l.detail;
+    EXPECT_GE(count(l.events, "slip"), 3);
+    EXPECT_LT(l.worst, 1e-9);
+    EXPECT_LT(l.worst_drop, 1e-10);
+    EXPECT_LT(l.worst_rise, 1e-9);
+    EXPECT_LE(l.e_max, 1.0 + 1e-9);
+    for (const auto& e : l.events)
+      if (e.time < 14.0) events[k].push_back(e);
+    ++k;
+  }
+  ASSERT_EQ(events[0].size(), events[1].size());
+  double largest = 0.0;
+  for (size_t i = 0; i < events[0].size(); ++i) largest = std::max(largest, std::abs(events[0][i].time - events[1][i].time));
+  std::printf("%zu events, largest time difference between the methods %.3g s\n", events[0].size(), largest);
+  for (size_t i = 0; i < events[0].size(); ++i) {
+    EXPECT_EQ(events[0][i].name, events[1][i].name);
+    EXPECT_NEAR(events[0][i].time, events[1][i].time, 1e-6) << events[0][i].name;
+  }
 }
 
 // The decoupled drilling torque -mu_d F_n sign(w_z) jumps where the spin about the vertical
@@ -98,19 +118,44 @@ TEST(ReferenceSlipStart, DecoupledSlipStartNeverDrivesTheSlip) {
 // step, whose dense output then missed its own starting state by 3.5e-2 rad/s in w_z; the
 // spin restarted there at the drill_stick event and E rose by 3.5e-8 E0 (7.4e-7 E0 before the
 // slip start's fix). Leine-Glocker top with mu_d = 1e-4 m at mu = 0.002: stick, slip start
-// (18.65 s), drilling stick (21.23 s), stick. Bounds as above.
+// (18.65 s), drilling stick (21.23 s), stick. Bounds as above; both methods (dopri5 stalled
+// at the slip start before, 18.64989 s).
 TEST(ReferenceSlipStart, DecoupledDrillingStickWithoutEnergyGain) {
-  Scene s = shipped("leine_glocker_drilling");
-  s.contact.mu = 0.002;
-  const Ledger l = run_ledger(s);
-  std::printf("leine_glocker_drilling mu 0.002: ledger %.3g E0, friction work drop %.3g E0, E rise %.3g E0\n", l.worst, l.worst_drop,
-              l.worst_rise);
-  ASSERT_EQ(l.status, ReferenceStatus::Ok) << l.detail;
-  EXPECT_EQ(count(l.events, "drill_stick"), 1);
-  EXPECT_GE(count(l.events, "slip"), 1);
-  EXPECT_LT(l.worst, 1e-9);
-  EXPECT_LT(l.worst_drop, 1e-10);
-  EXPECT_LT(l.worst_rise, 1e-9);
+  for (const char* method : {"bulirsch_stoer", "dopri5"}) {
+    Scene s = shipped("leine_glocker_drilling");
+    s.contact.mu = 0.002;
+    s.run.method = method;
+    const Ledger l = run_ledger(s);
+    std::printf("leine_glocker_drilling mu 0.002, %s: ledger %.3g E0, friction work drop %.3g E0, E rise %.3g E0\n", method, l.worst,
+                l.worst_drop, l.worst_rise);
+    ASSERT_EQ(l.status, ReferenceStatus::Ok) << method << ": " << l.detail;
+    EXPECT_EQ(count(l.events, "drill_stick"), 1);
+    EXPECT_GE(count(l.events, "slip"), 1);
+    EXPECT_LT(l.worst, 1e-9);
+    EXPECT_LT(l.worst_drop, 1e-10);
+    EXPECT_LT(l.worst_rise, 1e-9);
+  }
+}
+
+// A slip that ends without meeting zero head on: leine_glocker_drilling at mu = 0.02 slips at
+// 15.19 s and its slip, grown to 4.5e-6 m/s, shrinks again while its direction turns. Before a
+// small slip's direction was solved too (below slip_eps / 2), both methods stalled there
+// (15.2128 s bulirsch_stoer, 15.2123 s dopri5, steps of 2e-9 and 4e-11 s). Now 6 sticks and 6
+// slips by 20 s, the ledger as above.
+TEST(ReferenceSlipStart, ShrinkingSlipEndsWithoutStalling) {
+  for (const char* method : {"bulirsch_stoer", "dopri5"}) {
+    Scene s = shipped("leine_glocker_drilling");
+    s.contact.mu = 0.02;
+    s.run.method = method;
+    s.run.duration = 20.0;
+    const Ledger l = run_ledger(s);
+    std::printf("leine_glocker_drilling mu 0.02, %s: %d sticks, %d slips, ledger %.3g E0\n", method, count(l.events, "stick"),
+                count(l.events, "slip"), l.worst);
+    ASSERT_EQ(l.status, ReferenceStatus::Ok) << method << ": " << l.detail;
+    EXPECT_GE(count(l.events, "stick"), 2);
+    EXPECT_LT(l.worst, 1e-9);
+    EXPECT_LT(l.worst_drop, 1e-10);
+  }
 }
 
 // A cascade closed by a hold under Coulomb friction (the shipped hold scenes are viscous, whose
@@ -133,24 +178,18 @@ TEST(ReferenceSlipStart, CoulombHoldClosesTheLedger) {
     }
 }
 
-// Measured (Release): with dopri5 every decoupled slip start above stalls within 2 ms, the
-// energy balanced and not rising: "no progress" at 7.46335 s on the first test's top (last step
-// 5.7e-11 s), 18.64989 s on the second's (1.2e-10 s), 0.18267 s on the third's (1.0e-11 s);
-// rosenbrock4 at 7.46381 s (2.6e-9 s). The slip grows from zero (as c t^2, c = 6.7 m/s^3 on
-// the first top) while its direction relaxes at the rate mu F_n |W| / |v_C| (W the contact's
-// mobility), which has no bound as the slip starts: the explicit methods pin the slip at
-// ~1e-11 m/s with steps at their stability limit; Rosenbrock follows the slip but its
-// difference Jacobian perturbs v_G by more than the slip itself until ~1e-3 s after the start.
-// Bulirsch-Stoer's first long step passes over the phase. The same stall as the coupled
-// twin's (test_drilling_coupled.cpp). Not tuned: a documented case.
-TEST(ReferenceSlipStart, DISABLED_DecoupledSlipStartByDopri5) {
+// rosenbrock4 still stalls after the first slip start of the first test's top ("no progress"
+// at 7.46388 s, last step 2.9e-9 s): its difference Jacobian perturbs v_G by more than the
+// slip itself until the slip has grown past ~1e-6 m/s (as on the coupled twin,
+// test_drilling_coupled.cpp). A documented case.
+TEST(ReferenceSlipStart, DISABLED_DecoupledSlipStartByRosenbrock) {
   Scene s = shipped("leine_glocker");
   s.contact.mu = 0.02;
   s.initial.tilt = 1.0;
-  s.run.method = "dopri5";
-  s.run.duration = 15.0;
+  s.run.method = "rosenbrock4";
+  s.run.duration = 8.0;
   ReferenceModel m(s);
-  for (int k = 1; k <= 15000 && m.status() == ReferenceStatus::Ok; ++k) m.advance_to(1e-3 * k);
+  for (int k = 1; k <= 8000 && m.status() == ReferenceStatus::Ok; ++k) m.advance_to(1e-3 * k);
   EXPECT_EQ(m.status(), ReferenceStatus::Ok) << m.status_detail();
 }
 
