@@ -23,7 +23,7 @@ struct ContactSlot {
   bool drill_stick = false;  // spin about the vertical held at zero (drilling friction sticking)
   // Viscous law only: the contact touches with zero normal force and carries the fraction
   // `graze_fraction` in [0, 1] of its viscous force that keeps it on the floor (Filippov's
-  // sliding mode between "held" and "lifted", see reference_model.cpp). The motion is the
+  // sliding mode between "held" and "lifted", see reference_events.cpp). The motion is the
   // convex combination (1 - f) "lifted" + f "loaded": lifted has no force at the contact,
   // loaded its full viscous force and no normal force, the other contacts held in both; f
   // makes the contact's gap acceleration zero. Both fields are solved on their own, so the
@@ -110,7 +110,7 @@ class ContactDynamics {
     Unilateral,
     // Bilateral projection onto the contacts in `touching`: normal impulses of either sign that
     // zero their normal velocities with the smallest change of kinetic energy. Only for closing a Zeno
-    // cascade of impacts (see reference_model.cpp): there the pulling part stands for the
+    // cascade of impacts (see reference_events.cpp): there the pulling part stands for the
     // finite forces acting over the skipped bounces, not for a contact force.
     Bilateral,
   };
