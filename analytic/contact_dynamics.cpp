@@ -134,8 +134,9 @@ Vec3 ContactDynamics::slip_rate(const StateVector& y, const StateVector& dy, int
 ContactForces ContactDynamics::evaluate_slip_start(const StateVector& y, const ContactMode& mode, StateVector* dydt) const {
   // Newton on the unit sphere (the unit circle for the decoupled law) for G(n) = T (a(n) -
   // (a(n) . n) n) = 0, T a basis of the plane normal to n and a(n) the rate of the
-  // generalised slip when the friction takes the direction n: the direction in which a slip
-  // started from zero grows (a = lambda n; the root with lambda >= 0 nearest the guess).
+  // generalised slip when the friction takes the direction n: the direction along which a small
+  // slip grows or shrinks (a = lambda n; the root nearest the guess, the last direction: lambda
+  // > 0 for a slip started from zero, < 0 for one dying out).
   // The Jacobian by differences of 1e-7 rad (right to ~1e-7, so each iteration gains seven
   // digits); iterations to an angle of 1e-14, so that the right-hand side is smooth in the
   // state to round-off (the step control sees no noise from the solve).
@@ -180,7 +181,7 @@ ContactForces ContactDynamics::evaluate_slip_start(const StateVector& y, const C
           delta = J.fullPivLu().solve(-g0);
         }
         // A step of at most 0.5 rad: Newton from a guess far from the root must not jump to
-        // the antipodal root (lambda < 0, the slip shrinking against its force).
+        // another root (e.g. the antipodal one, on which lambda has the other sign).
         const double len = delta.norm();
         if (!std::isfinite(len)) break;
         if (len > 0.5) delta *= 0.5 / len;

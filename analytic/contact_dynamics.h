@@ -45,13 +45,13 @@ struct ContactSlot {
   // Coupled law: below this generalised slip |(mu v, mu_d w_z)| the direction is coupled_dir
   // (a slip zeroed at a restart is round-off, whose direction means nothing).
   double coupled_floor = 0.0;
-  // Coulomb law (either drilling law), sliding: the slip has just started from zero and is
-  // still below the reference's threshold. Its direction is then not the slip's own but the
-  // one in which the slip grows: the unit n (slip_dir_W, or coupled_dir under the coupled law)
-  // with d(slip)/dt = lambda n, lambda >= 0, solved at every evaluation (the slow manifold of
-  // the direction, whose own relaxation rate mu F_n |W| / |slip| has no bound as the slip
-  // starts; integrated as it is, that stiff phase stalled every method). slip_dir_W or
-  // coupled_dir is the starting guess of the solve.
+  // Coulomb law (either drilling law), sliding: the slip is small (it has just started from
+  // zero, or fallen below half of the reference's threshold). Its direction is then not the
+  // slip's own but the one along which the slip grows or shrinks: the unit n (slip_dir_W, or
+  // coupled_dir under the coupled law) with d(slip)/dt = lambda n, solved at every evaluation
+  // (the slow manifold of the direction, whose own relaxation rate mu F_n |W| / |slip| has no
+  // bound as the slip starts or ends; integrated as it is, that stiff phase stalled every
+  // method). slip_dir_W or coupled_dir is the starting guess of the solve.
   bool slip_start = false;
 };
 
