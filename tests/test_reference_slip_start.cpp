@@ -179,9 +179,8 @@ TEST(ReferenceSlipStart, CoulombHoldClosesTheLedger) {
 }
 
 // rosenbrock4 still stalls after the first slip start of the first test's top ("no progress"
-// at 7.46388 s, last step 2.9e-9 s): its difference Jacobian perturbs v_G by more than the
-// slip itself until the slip has grown past ~1e-6 m/s (as on the coupled twin,
-// test_drilling_coupled.cpp). A documented case.
+// at 7.46388 s, last step 2.9e-9 s), as on the coupled twin (test_drilling_coupled.cpp, where
+// the suspect is named). A documented case.
 TEST(ReferenceSlipStart, DISABLED_DecoupledSlipStartByRosenbrock) {
   Scene s = shipped("leine_glocker");
   s.contact.mu = 0.02;
