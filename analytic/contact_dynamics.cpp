@@ -88,7 +88,12 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
       grazing = s;
       ++n_grazing;
     }
-  if (n_grazing == 0) return evaluate_fixed(y, mode, dydt, 1.0);
+  if (n_grazing == 0) {
+    for (int s = 0; s < 2; ++s)
+      if (c_.friction == FrictionLaw::Coulomb && mode.slot[s].active && !mode.slot[s].stick && mode.slot[s].slip_start)
+        return evaluate_slip_start(y, mode, dydt);
+    return evaluate_fixed(y, mode, dydt, 1.0);
+  }
   // Filippov's combination of the lifted (share 0) and the loaded (share 1) fields; both are
   // linear in the share, so the combination is the exact solution at the share found.
   StateVector d0, d1;
@@ -112,6 +117,86 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
   out.normal[s] = 0.0;
   if (dydt)
     for (size_t i = 0; i < d0.size(); ++i) (*dydt)[i] = (1 - f) * d0[i] + f * d1[i];
+  return out;
+}
+
+Vec3 ContactDynamics::slip_rate(const StateVector& y, const StateVector& dy, int s) const {
+  const BodyState x = unpack(y, 0);
+  const Quat q = x.q_WB.normalized();
+  const Vec3 w_W = q * x.w_B, wdot_W = q * Vec3(dy[10], dy[11], dy[12]);
+  const ContactGeometry geo = geometry(x, s);
+  // d/dt (v_G + w x r_GC), r_GC = r_GO - radius e_z with r_GO fixed in the body.
+  const Vec3 a = Vec3(dy[3], dy[4], dy[5]) + wdot_W.cross(geo.r_GC_W) + w_W.cross(w_W.cross(geo.r_GO_W));
+  if (coupled()) return Vec3(c_.mu * a.x(), c_.mu * a.y(), c_.drilling * wdot_W.z());
+  return Vec3(a.x(), a.y(), 0.0);
+}
+
+ContactForces ContactDynamics::evaluate_slip_start(const StateVector& y, const ContactMode& mode, StateVector* dydt) const {
+  // Newton on the unit sphere (the unit circle for the decoupled law) for G(n) = T (a(n) -
+  // (a(n) . n) n) = 0, T a basis of the plane normal to n and a(n) the rate of the
+  // generalised slip when the friction takes the direction n: the direction along which a small
+  // slip grows or shrinks (a = lambda n; the root nearest the guess, the last direction: lambda
+  // > 0 for a slip started from zero, < 0 for one dying out).
+  // The Jacobian by differences of 1e-7 rad (right to ~1e-7, so each iteration gains seven
+  // digits); iterations to an angle of 1e-14, so that the right-hand side is smooth in the
+  // state to round-off (the step control sees no noise from the solve).
+  ContactMode m = mode;
+  const bool three = coupled();
+  StateVector dy{};
+  for (int sweep = 0; sweep < 2; ++sweep)
+    for (int s = 0; s < 2; ++s) {
+      ContactSlot& slot = m.slot[s];
+      if (!slot.active || slot.stick || !slot.slip_start) continue;
+      Vec3& dir = three ? slot.coupled_dir : slot.slip_dir_W;
+      if (!three) dir.z() = 0.0;
+      dir.normalize();
+      auto rate = [&](const Vec3& n) {
+        dir = n;
+        StateVector d;
+        evaluate_fixed(y, m, &d, 1.0);
+        return slip_rate(y, d, s);
+      };
+      for (int iter = 0; iter < 30; ++iter) {
+        const Vec3 n = dir;
+        Vec3 t1 = three ? n.unitOrthogonal() : Vec3(-n.y(), n.x(), 0.0);
+        Vec3 t2 = n.cross(t1);
+        const int k = three ? 2 : 1;
+        const Vec3 basis[2] = {t1, t2};
+        auto G = [&](const Vec3& nn) {
+          const Vec3 a = rate(nn);
+          const Vec3 p = a - a.dot(nn) * nn;
+          return Eigen::Vector2d(basis[0].dot(p), basis[1].dot(p));
+        };
+        const Eigen::Vector2d g0 = G(n);
+        constexpr double h = 1e-7;
+        Eigen::Matrix2d J = Eigen::Matrix2d::Identity();
+        for (int j = 0; j < k; ++j) {
+          const Eigen::Vector2d gj = G((n + h * basis[j]).normalized());
+          J.col(j) = (gj - g0) / h;
+        }
+        Eigen::Vector2d delta = Eigen::Vector2d::Zero();
+        if (k == 1) {
+          delta(0) = J(0, 0) != 0.0 ? -g0(0) / J(0, 0) : 0.0;
+        } else {
+          delta = J.fullPivLu().solve(-g0);
+        }
+        // A step of at most 0.5 rad: Newton from a guess far from the root must not jump to
+        // another root (e.g. the antipodal one, on which lambda has the other sign).
+        const double len = delta.norm();
+        if (!std::isfinite(len)) break;
+        if (len > 0.5) delta *= 0.5 / len;
+        dir = (n + delta(0) * basis[0] + delta(1) * basis[1]).normalized();
+        if (len < 1e-14) break;
+      }
+    }
+  ContactForces out = evaluate_fixed(y, m, &dy, 1.0);
+  for (int s = 0; s < 2; ++s) {
+    const ContactSlot& slot = m.slot[s];
+    if (!slot.active || slot.stick || !slot.slip_start) continue;
+    out.start_dir[s] = three ? slot.coupled_dir : slot.slip_dir_W;
+    out.start_rate[s] = slip_rate(y, dy, s).dot(out.start_dir[s]);
+  }
+  if (dydt) *dydt = dy;
   return out;
 }
 
@@ -181,7 +266,7 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
       // direction below, so that the dense output stays smooth through a zero of u.
       const Vec3 u(c_.mu * slip.x(), c_.mu * slip.y(), c_.drilling * w_W.z());  // coupled_slip()
       const double S = u.norm();
-      Vec3 dir = S > slot.coupled_floor ? Vec3(u / S) : slot.coupled_dir;
+      Vec3 dir = S > slot.coupled_floor && !slot.slip_start ? Vec3(u / S) : slot.coupled_dir;
       if (dir.dot(slot.coupled_dir) < 0) dir = -dir;
       fdir -= c_.mu * Vec3(dir.x(), dir.y(), 0.0);
       drill_coeff = -c_.drilling * dir.z();
@@ -192,7 +277,7 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
       // integrator never steps over a kink and the "slip vanishes" event is located on a
       // smooth dense output. The reference is refreshed every step.
       const double speed = slip.norm();
-      Vec3 dir = speed > 0.0 ? Vec3(slip / speed) : slot.slip_dir_W;
+      Vec3 dir = speed > 0.0 && !slot.slip_start ? Vec3(slip / speed) : slot.slip_dir_W;
       if (dir.dot(slot.slip_dir_W) < 0) dir = -dir;
       fdir -= c_.mu * dir;
     }
@@ -217,7 +302,8 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
     }
     if (c_.drilling > 0.0 && !slot.drill_stick && !coupled_sliding) {
       const double spin_z = w_W.z();
-      drill_coeff = spin_z > 0 ? -c_.drilling : (spin_z < 0 ? c_.drilling : 0.0);
+      const double sign = slot.drill_dir != 0.0 ? slot.drill_dir : (spin_z > 0 ? 1.0 : (spin_z < 0 ? -1.0 : 0.0));
+      drill_coeff = -c_.drilling * sign;
     }
     idx[s].normal = n;
     idx[s].normal_dir = fdir;
@@ -317,146 +403,6 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
     d[10] = wdot_B.x(); d[11] = wdot_B.y(); d[12] = wdot_B.z();
   }
   return out;
-}
-
-BodyState ContactDynamics::impact(const BodyState& x, std::array<bool, 2> touching, std::array<bool, 2>* kept,
-                                  std::array<double, 2>* normal_impulse, Impulses kind) const {
-  const bool both_normal_only = kind == Impulses::Bilateral;
-  const bool normal_only = kind != Impulses::Impact;
-  const Quat q = x.q_WB.normalized();
-  const Eigen::Matrix3d R_WB = q.toRotationMatrix();
-  const Vec3 I_B(m_.A, m_.A, m_.C);
-  const Eigen::Matrix3d Iinv_W = R_WB * I_B.cwiseInverse().asDiagonal() * R_WB.transpose();
-  const Vec3 w_W = q * x.w_B;
-  ContactGeometry g[2] = {geometry(x, 0), geometry(x, 1)};
-  Vec3 v_pre[2];
-  for (int s = 0; s < 2; ++s) v_pre[s] = x.v_WG + w_W.cross(g[s].r_GC_W);
-
-  // Velocity change of contact point i per unit impulse f at contact j.
-  auto response = [&](int i, int j, const Vec3& f) {
-    const Vec3 dw = Iinv_W * g[j].r_GC_W.cross(f);
-    return Vec3(f / m_.M + dw.cross(g[i].r_GC_W));
-  };
-  // Tangential impulses: rolling stops the whole contact velocity; Coulomb tries that and,
-  // outside the cone, slides along the pre-impact slip; viscous and none have no impulsive
-  // friction (a finite force transmits no impulse). Gliding friction is left out of impacts
-  // too (normal impulse only): strictly its force -mu F_n v_C follows an impulsive F_n with
-  // the impulse -mu integral(v_C dP_n), a simplification of this model that matters only where
-  // a gliding top touches down (the bare ball never does). Drilling friction (either law)
-  // transmits no impulse here either, and under the coupled law the tangential impulse is
-  // bounded by the Coulomb cone alone (mu P_n), not by the ellipse with an impulsive drilling
-  // torque: a simplification that bounds the tangential impulse from above (the ellipse
-  // would share the bound with the spin), and matters only from the first stem touchdown on.
-  const bool full_stop = !normal_only && (c_.friction == FrictionLaw::Rolling || c_.friction == FrictionLaw::Coulomb);
-
-  struct Solution {
-    bool ok = false;
-    Vec3 P[2] = {Vec3::Zero(), Vec3::Zero()};
-  };
-  auto solve = [&](std::array<bool, 2> in_set, std::array<bool, 2> sliding) {
-    Solution sol;
-    Column cols[6];
-    int owner[6], n = 0;
-    std::array<int, 2> first{-1, -1};
-    Row rows[6];
-    for (int s = 0; s < 2; ++s) {
-      if (!in_set[s]) continue;
-      first[s] = n;
-      Vec3 ndir = Vec3::UnitZ();
-      if (sliding[s]) {
-        Vec3 t = v_pre[s];
-        t.z() = 0;
-        if (t.norm() > 0) ndir -= c_.mu * t.normalized();
-      }
-      cols[n] = {ndir, Vec3::Zero()};
-      rows[n] = {Vec3::UnitZ(), Vec3::Zero(), v_pre[s].z()};
-      owner[n++] = s;
-      if (full_stop && !sliding[s]) {
-        for (int a = 0; a < 2; ++a) {
-          const Vec3 dir = a == 0 ? Vec3(Vec3::UnitX()) : Vec3(Vec3::UnitY());
-          cols[n] = {dir, Vec3::Zero()};
-          rows[n] = {dir, Vec3::Zero(), v_pre[s].dot(dir)};
-          owner[n++] = s;
-        }
-      }
-    }
-    MatN K(n, n);
-    VecN b(n);
-    for (int i = 0; i < n; ++i) {
-      b(i) = -rows[i].bias;
-      for (int j = 0; j < n; ++j) K(i, j) = rows[i].f.dot(response(owner[i], owner[j], cols[j].f));
-    }
-    const auto lu = K.fullPivLu();
-    if (!lu.isInvertible()) return sol;
-    const VecN u = lu.solve(b);
-    for (int j = 0; j < n; ++j) sol.P[owner[j]] += cols[j].f * u(j);
-    sol.ok = true;
-    if (both_normal_only) return sol;
-    for (int s = 0; s < 2; ++s) {
-      if (!in_set[s]) continue;
-      if (sol.P[s].z() < 0) sol.ok = false;
-    }
-    // Contacts left out of the set must not approach the floor afterwards.
-    for (int s = 0; s < 2; ++s) {
-      if (!touching[s] || in_set[s]) continue;
-      Vec3 v = v_pre[s];
-      for (int j = 0; j < 2; ++j) v += response(s, j, sol.P[j]);
-      if (v.z() < -1e-12 * std::max(1.0, v_pre[s].norm())) sol.ok = false;
-    }
-    return sol;
-  };
-
-  const std::array<std::array<bool, 2>, 3> sets = {{{true, false}, {false, true}, {true, true}}};
-  Solution best;
-  if (kind == Impulses::Unilateral) {
-    // Nothing approaching: no impulse (the empty set solves the complementarity problem).
-    bool approaching = false;
-    for (int s = 0; s < 2; ++s) approaching = approaching || (touching[s] && v_pre[s].z() < 0);
-    if (!approaching) {
-      if (kept) *kept = {false, false};
-      if (normal_impulse) *normal_impulse = {0.0, 0.0};
-      return x;
-    }
-  }
-  for (const auto& set : sets) {
-    if (both_normal_only && set != touching) continue;
-    if ((set[0] && !touching[0]) || (set[1] && !touching[1])) continue;
-    std::array<bool, 2> sliding{false, false};
-    Solution sol = solve(set, sliding);
-    if (sol.ok && c_.friction == FrictionLaw::Coulomb) {
-      bool redo = false;
-      for (int s = 0; s < 2; ++s) {
-        const double pt = std::hypot(sol.P[s].x(), sol.P[s].y());
-        if (set[s] && pt > c_.mu * sol.P[s].z()) sliding[s] = redo = true;
-      }
-      if (redo) sol = solve(set, sliding);
-    }
-    if (sol.ok) {
-      best = sol;
-      break;
-    }
-  }
-  BodyState post = x;
-  if (!best.ok) {
-    if (kept) *kept = {false, false};
-    return post;
-  }
-  Vec3 dv = Vec3::Zero(), dL = Vec3::Zero();
-  for (int s = 0; s < 2; ++s) {
-    dv += best.P[s];
-    dL += g[s].r_GC_W.cross(best.P[s]);
-    if (normal_impulse) (*normal_impulse)[s] = best.P[s].z();
-  }
-  post.v_WG = x.v_WG + dv / m_.M;
-  const Vec3 w_post_W = w_W + Iinv_W * dL;
-  post.w_B = q.conjugate() * w_post_W;
-  if (kept) {
-    for (int s = 0; s < 2; ++s) {
-      const Vec3 v = post.v_WG + w_post_W.cross(g[s].r_GC_W);
-      (*kept)[s] = touching[s] && std::abs(v.z()) <= 1e-9 * std::max(1.0, v_pre[s].norm());
-    }
-  }
-  return post;
 }
 
 }  // namespace tippe

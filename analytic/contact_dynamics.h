@@ -23,7 +23,7 @@ struct ContactSlot {
   bool drill_stick = false;  // spin about the vertical held at zero (drilling friction sticking)
   // Viscous law only: the contact touches with zero normal force and carries the fraction
   // `graze_fraction` in [0, 1] of its viscous force that keeps it on the floor (Filippov's
-  // sliding mode between "held" and "lifted", see reference_model.cpp). The motion is the
+  // sliding mode between "held" and "lifted", see reference_events.cpp). The motion is the
   // convex combination (1 - f) "lifted" + f "loaded": lifted has no force at the contact,
   // loaded its full viscous force and no normal force, the other contacts held in both; f
   // makes the contact's gap acceleration zero. Both fields are solved on their own, so the
@@ -31,6 +31,13 @@ struct ContactSlot {
   // (the slip passing through 0, where both fields meet).
   bool graze = false;
   Vec3 slip_dir_W = Vec3::UnitX();  // Coulomb sliding direction used while |v_C| is ~0
+  // Decoupled drilling law only: the sign of the spin about the vertical that the sliding
+  // drilling torque opposes (+1 or -1; 0: the sign of the spin itself). Kept through a zero of
+  // the spin within a step, as slip_dir_W is, so that the integrator never steps over the jump
+  // of sign(w_z): on Bulirsch-Stoer that jump inside a step made the step's dense output miss
+  // its own starting state by 3.5e-2 rad/s in w_z, and the spin restarted there (leine_glocker_drilling
+  // at mu = 0.002: E rose by 3.5e-8 E0 at the drill_stick event).
+  double drill_dir = 0.0;
   // Coupled drilling law only: the sliding direction in the generalised slip space
   // (mu v_x, mu v_y, mu_d w_z) (lab axes), a unit vector, used while that slip is ~0 (as
   // slip_dir_W). `stick` and `drill_stick` are then set together: the law sticks only as a whole.
@@ -38,6 +45,14 @@ struct ContactSlot {
   // Coupled law: below this generalised slip |(mu v, mu_d w_z)| the direction is coupled_dir
   // (a slip zeroed at a restart is round-off, whose direction means nothing).
   double coupled_floor = 0.0;
+  // Coulomb law (either drilling law), sliding: the slip is small (it has just started from
+  // zero, or fallen below half of the reference's threshold). Its direction is then not the
+  // slip's own but the one along which the slip grows or shrinks: the unit n (slip_dir_W, or
+  // coupled_dir under the coupled law) with d(slip)/dt = lambda n, solved at every evaluation
+  // (the slow manifold of the direction, whose own relaxation rate mu F_n |W| / |slip| has no
+  // bound as the slip starts or ends; integrated as it is, that stiff phase stalled every
+  // method). slip_dir_W or coupled_dir is the starting guess of the solve.
+  bool slip_start = false;
 };
 
 struct ContactMode {
@@ -58,6 +73,12 @@ struct ContactForces {
   std::array<double, 2> graze_lifted_accel{0, 0};
   std::array<double, 2> graze_loaded_accel{0, 0};
   std::array<double, 2> graze_fraction_raw{1, 1};
+  // Slip-start contacts only (ContactSlot::slip_start): the direction n solved (lab x, y and,
+  // under the coupled law, the drilling component) and the slip's growth rate lambda along it
+  // (generalised slip units per second: m/s^2 for the decoupled law, those of coupled_slip()
+  // per second for the coupled one).
+  std::array<Vec3, 2> start_dir{Vec3::UnitX(), Vec3::UnitX()};
+  std::array<double, 2> start_rate{0, 0};
   bool solvable = true;
 };
 
@@ -89,7 +110,7 @@ class ContactDynamics {
     Unilateral,
     // Bilateral projection onto the contacts in `touching`: normal impulses of either sign that
     // zero their normal velocities with the smallest change of kinetic energy. Only for closing a Zeno
-    // cascade of impacts (see reference_model.cpp): there the pulling part stands for the
+    // cascade of impacts (see reference_events.cpp): there the pulling part stands for the
     // finite forces acting over the skipped bounces, not for a contact force.
     Bilateral,
   };
@@ -97,6 +118,12 @@ class ContactDynamics {
   // velocity is ~0 afterwards; `normal_impulse`: the normal impulse per slot.
   BodyState impact(const BodyState& x, std::array<bool, 2> touching, std::array<bool, 2>* kept,
                    std::array<double, 2>* normal_impulse, Impulses kind = Impulses::Impact) const;
+
+  // The state with the material point at the contact of `slot` at rest (and, with `spin`, the
+  // spin about the vertical stopped too), by the impulse (and angular impulse about the
+  // vertical) at the contact that does it with the smallest change of kinetic energy: a
+  // projection in the mass metric, so it can only remove energy (positions unchanged).
+  BodyState stop_contact(const BodyState& x, int slot, bool spin) const;
 
   // Acceleration of the centre of the contact sphere of `slot` along z, from a state derivative.
   double gap_acceleration(const StateVector& y, const StateVector& dydt, int slot) const;
@@ -117,6 +144,11 @@ class ContactDynamics {
   double coupled_demand(const ContactForces& f, int slot) const;
 
  private:
+  // evaluate() with the slip-start contacts' directions solved (ContactSlot::slip_start).
+  ContactForces evaluate_slip_start(const StateVector& y, const ContactMode& mode, StateVector* dydt) const;
+  // Rate of the generalised slip of slot s (lab x, y of the contact point's velocity, times mu
+  // under the coupled law, and mu_d dw_z/dt there) from a state derivative.
+  Vec3 slip_rate(const StateVector& y, const StateVector& dy, int s) const;
   // evaluate() with every grazing contact carrying the fixed share `share` of its viscous force.
   ContactForces evaluate_fixed(const StateVector& y, const ContactMode& mode, StateVector* dydt, double share) const;
   BodyModel m_;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "../analytic/reference_model.h"
 #include "io/scene_io.h"
@@ -234,24 +235,70 @@ TEST(DrillingCoupled, StickThenSlipOnTheTwin) {
   EXPECT_LT(worst_drop, 1e-14);
 }
 
-// Measured (Release): after that slip start every method stalls within 0.6 ms, with the energy
-// balanced and not rising: "no progress" at t = 17.12174 (bulirsch_stoer, last step 4.5e-9 s),
-// 17.12098 (dopri5, 8.7e-10 s), 17.12087 (rosenbrock4, 1.1e-10 s). The slip grows from zero
-// with a direction that turns at a rate ~F_n |M| / |slip| (M the generalised mobility, whose
-// translational and drilling parts differ ~1000-fold on this top), a stiff phase no step
-// control here gets through. Before the reference zeroed the stuck drift and counted a start
-// from zero slip as a SlipReversal crossing, dopri5 went on with the force driving the slip
-// (the energy rose from 9e-4 to 2.3e-3 J within 0.14 s): a stall is the honest outcome. Left
-// as a documented case beyond the scene's 10 s horizon; not tuned.
-TEST(DrillingCoupled, DISABLED_SlidesOnAfterTheSlipOnTheTwin) {
-  for (const char* method : {"bulirsch_stoer", "dopri5", "rosenbrock4"}) {
+// After that slip start the twin slides on, sticks and slips again: 16 stick/slip pairs by
+// 20 s. Before the reference solved a starting slip's direction (ContactSlot::slip_start),
+// every method stalled within 0.6 ms of the first slip start ("no progress" at 17.12174 s on
+// bulirsch_stoer, 17.12098 s on dopri5, 17.12087 s on rosenbrock4): the slip grew from zero
+// with a direction relaxing at a rate ~F_n |M| / |slip| (M the generalised mobility), a stiff
+// phase no step control got through. Run to 17.6 s (two slip starts), sample by sample as the
+// harness runs it: both explicit methods get through, the ledger closes to 1e-9 E0 (as above)
+// and the friction work never falls (a stuck contact's force on its drift may move it by
+// the tolerance: 1e-12 E0), and the two methods' stick and slip events agree to 1e-6 s
+// (measured 4.1e-8 s; where slip and spin vanish together the stick time is ill-conditioned,
+// hence the margin).
+TEST(DrillingCoupled, SlidesOnAfterTheSlipOnTheTwin) {
+  std::vector<ReferenceEvent> events[2];
+  int k_method = 0;
+  for (const char* method : {"bulirsch_stoer", "dopri5"}) {
     Scene s = shipped("leine_glocker_twin_coupled");
     s.run.method = method;
-    s.run.duration = 17.2;
+    s.run.duration = 17.6;
     ReferenceModel m(s);
-    for (int k = 1; k <= 17200 && m.status() == ReferenceStatus::Ok; ++k) m.advance_to(1e-3 * k);
-    EXPECT_EQ(m.status(), ReferenceStatus::Ok) << method << ": " << m.status_detail();
+    const BodyModel& b = m.body();
+    const double e0 = energy(b, m.state());
+    double w_prev = 0.0, worst_drop = 0.0, worst_ledger = 0.0;
+    for (int k = 1; k <= 17600 && m.status() == ReferenceStatus::Ok; ++k) {
+      m.advance_to(1e-3 * k);
+      const double w = m.energy_ledger().friction;
+      worst_drop = std::max(worst_drop, (w_prev - w) / e0);
+      w_prev = w;
+      worst_ledger = std::max(worst_ledger, std::abs(energy(b, m.state()) + m.energy_ledger().total() - e0) / e0);
+    }
+    ASSERT_EQ(m.status(), ReferenceStatus::Ok) << method << ": " << m.status_detail();
+    int sticks = 0, slips = 0;
+    for (const auto& e : m.events()) {
+      if (e.name == "stick" || e.name == "slip") events[k_method].push_back(e);
+      sticks += e.name == "stick";
+      slips += e.name == "slip";
+    }
+    std::printf("twin to 17.6 s, %s: %d sticks, %d slips; ledger %.3g E0, friction work drop %.3g E0\n", method, sticks, slips,
+                worst_ledger, worst_drop);
+    EXPECT_EQ(sticks, 3) << method;
+    EXPECT_EQ(slips, 3) << method;
+    EXPECT_LT(worst_ledger, 1e-9) << method;
+    EXPECT_LT(worst_drop, 1e-12) << method;
+    ++k_method;
   }
+  ASSERT_EQ(events[0].size(), events[1].size());
+  double largest = 0.0;
+  for (size_t i = 0; i < events[0].size(); ++i) largest = std::max(largest, std::abs(events[0][i].time - events[1][i].time));
+  std::printf("%zu events, largest time difference between the methods %.3g s\n", events[0].size(), largest);
+  for (size_t i = 0; i < events[0].size(); ++i) {
+    EXPECT_EQ(events[0][i].name, events[1][i].name);
+    EXPECT_NEAR(events[0][i].time, events[1][i].time, 1e-6) << events[0][i].name << " " << i;
+  }
+}
+
+// rosenbrock4 still stalls after the slip start: "no progress" at 17.12461 s (last step 2.0e-9
+// s). Not investigated; the suspect is its Jacobian by central differences of the sliding
+// law, whose derivatives scale as 1 / |slip| while the slip is small. A documented case.
+TEST(DrillingCoupled, DISABLED_SlidesOnAfterTheSlipOnTheTwinRosenbrock) {
+  Scene s = shipped("leine_glocker_twin_coupled");
+  s.run.method = "rosenbrock4";
+  s.run.duration = 17.2;
+  ReferenceModel m(s);
+  for (int k = 1; k <= 17200 && m.status() == ReferenceStatus::Ok; ++k) m.advance_to(1e-3 * k);
+  EXPECT_EQ(m.status(), ReferenceStatus::Ok) << m.status_detail();
 }
 
 // Leine and Glocker: with the coupled law their top turns over and touches its stem within
@@ -276,10 +323,11 @@ TEST(DrillingCoupled, CoupledLawTurnsTheLeineGlockerTopOver) {
 // read off Leine and Glocker's figure; two significant digits put it within +-0.05 s. The
 // methods agree to 1e-6 s (rtol 1e-10 over 1.4 s of motion).
 // Measured: bulirsch_stoer 1.3733177 s, dopri5 the same to 1e-6; 0.127 s (8.5 %) before the
-// published value, outside +-0.05 s. A finding, not tuned (BENCHMARKS.md: the ellipse
-// against the exact Contensou set, mu_d of a uniform against a Hertzian patch, and a reading
-// of their figure are the candidate causes; MuJoCo's elliptic cone, the same law, touches at
-// 1.4186 s).
+// published value, outside +-0.05 s. A finding, not tuned (BENCHMARKS.md). Excluded: the
+// exact Contensou set of a uniform patch instead of the ellipse (1.37233 s, 1.0 ms earlier),
+// mu_d of a Hertzian instead of a uniform patch (2 ms). Left: their time stepping and the
+// reading of their figure; a patch of ~1.2 mm instead of 0.5 mm would give 1.5 s. MuJoCo's
+// elliptic cone, the same law, touches at 1.4186 s.
 TEST(DrillingCoupled, DISABLED_StemTouchdownAtThePublishedTime) {
   Scene s = shipped("leine_glocker_coupled");
   ReferenceModel m(s);
