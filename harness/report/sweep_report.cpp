@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -88,6 +89,16 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
                                  "nothing here, so the regime of every point is what counts";
   ref += s.reference_stem_contact ? "; its stem first touches at t = " + fmt("%.10g", *s.reference_stem_contact) + "."
                                   : "; its stem never touches.";
+  // The reference's self-check (records' metrics.reference_converged_until): the same for every
+  // point of the scene, since all are compared with the one reference.
+  std::optional<double> converged_until;
+  for (const SetupGroup& u : s.setups)
+    for (const SweepRecord& r : u.points)
+      if (r.metrics.reference_converged_until) converged_until = r.metrics.reference_converged_until;
+  if (converged_until)
+    ref += " Its self-check (a second reference by an independent method) parts from it at t = " +
+           fmt("%.6g", *converged_until) + ": every metric against the reference below stops there, and an "
+           "event after it is not judged (\"unconverged\").";
   doc.para(ref);
 
   std::vector<SweepRecord> all, analytic;

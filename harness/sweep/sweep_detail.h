@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "measure/compare.h"
 #include "sweep/sweep.h"
@@ -17,6 +18,10 @@ struct Reference {
   RunRecord record;
   Trajectory trajectory;
   std::optional<SweepRecord::ReferenceRun> summary;  // filled once loaded or computed
+  // Its self-check (the scene's engines.analytic.self_check, on by default): a second reference
+  // by an independent method; every point's metrics against the reference stop at its
+  // converged_until, as in a comparison. Absent: not asked for.
+  std::optional<SelfCheck> self_check;
   // A reference that failed is a result: every point of its scene is recorded as failed with
   // this reason (non-empty) instead of being run against nothing.
   std::string failure;
@@ -28,20 +33,32 @@ struct Reference {
 SweepRecord reference_failed_record(SweepRecord r, const Scene& scene, const Reference& ref);
 SweepRecord::ReferenceRun reference_summary(const Scene& scene, const Reference& ref);
 
-// The reference's two cache files as texts, "summary.json" then "trajectory.csv", each behind its
-// length: what a worker sends back and what the coordinator shares with every rank.
-std::string pack_texts(const std::string& summary, const std::string& csv);
-// Reads one pack_texts pair at `pos` (advanced past it); throws std::runtime_error when cut short.
-std::pair<std::string, std::string> unpack_texts(const std::string& bytes, size_t& pos);
-// What a reference's task sends back: 'R' and its two cache files' texts, or 'F' and, for a
-// reference that failed, the time and the reason (a result, not an error: its scene's points are
-// recorded as failed).
+// Texts each behind its length: what a worker sends back and what the coordinator shares with
+// every rank.
+std::string pack_texts(const std::vector<std::string>& texts);
+// Reads `count` pack_texts fields at `pos` (advanced past them); throws std::runtime_error when
+// cut short.
+std::vector<std::string> unpack_texts(const std::string& bytes, size_t& pos, size_t count);
+// A reference as a message: 'R' and its cache files' texts, "summary.json", "trajectory.csv" and
+// its self-check as JSON ("null" when not asked for).
+std::string reference_text(const std::string& summary, const std::string& csv, const std::optional<SelfCheck>& check);
+// Reads a reference_text's three fields after its 'R' at `pos`.
+struct ReferenceTexts {
+  std::string summary, csv;
+  std::optional<SelfCheck> self_check;
+};
+ReferenceTexts read_reference_text(const std::string& bytes, size_t& pos);
+// What a reference's task sends back: a reference_text, or 'F' and, for a reference that
+// failed, the time and the reason (a result, not an error: its scene's points are recorded as
+// failed).
 std::string failed_reference_text(double time, const std::string& why);
 // Reads a failed_reference_text at `pos` into ref; false (pos unmoved) for an 'R' entry.
 bool read_failed_reference(const std::string& bytes, size_t& pos, Reference& ref);
-// Runs the reference at the scene's own tolerances, on whichever process the task lands.
+// Runs the reference at the scene's own tolerances, on whichever process the task lands, and
+// (scene.run.self_check) its self-check beside it.
 std::string compute_reference_texts(const Scene& scene);
-// Into the cache dir and into memory, read back from the very texts every other rank will read.
+// Into the cache dir (summary.json, trajectory.csv, self_check.json) and into memory, read back
+// from the very texts every other rank will read.
 void store_reference(const std::filesystem::path& dir, const Scene& scene, const std::string& hash,
                      const std::string& texts, Reference& ref);
 

@@ -110,7 +110,9 @@ SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Referenc
   r.status_detail = first.status_detail;
   r.inversion_time = first.inversion_time;
   r.stem_contact_time = first.stem_contact_time;
-  r.metrics = compare_runs(ref.record, ref.trajectory, first, sink.trajectory, p.scene);
+  // Against the reference only as far as its self-check says it is converged (as a comparison does).
+  r.metrics = compare_runs(ref.record, ref.trajectory, first, sink.trajectory, p.scene,
+                           ref.self_check ? ref.self_check->converged_until : std::nullopt);
   r.cpu_seconds = cpu_min;
   r.wall_seconds = wall_min;
   r.metrics.cpu_seconds = cpu_min;

@@ -62,31 +62,42 @@ SweepRecord::ReferenceRun reference_summary(const Scene& scene, const Reference&
 }
 
 
-// The reference's two cache files as texts, "summary.json" then "trajectory.csv", each behind its
-// length: what a worker sends back and what the coordinator shares with every rank.
-std::string pack_texts(const std::string& summary, const std::string& csv) {
-  return std::to_string(summary.size()) + "\n" + summary + std::to_string(csv.size()) + "\n" + csv;
+std::string pack_texts(const std::vector<std::string>& texts) {
+  std::string out;
+  for (const std::string& t : texts) out += std::to_string(t.size()) + "\n" + t;
+  return out;
 }
-// Reads one pack_texts pair at `pos` (advanced past it); throws std::runtime_error when cut short.
-std::pair<std::string, std::string> unpack_texts(const std::string& bytes, size_t& pos) {
-  auto field = [&]() {
+
+std::vector<std::string> unpack_texts(const std::string& bytes, size_t& pos, size_t count) {
+  std::vector<std::string> out;
+  for (size_t k = 0; k < count; ++k) {
     const size_t nl = bytes.find('\n', pos);
     if (nl == std::string::npos) throw std::runtime_error("reference message cut short");
     const size_t n = std::stoull(bytes.substr(pos, nl - pos));
     if (nl + 1 + n > bytes.size()) throw std::runtime_error("reference message cut short");
-    std::string text = bytes.substr(nl + 1, n);
+    out.push_back(bytes.substr(nl + 1, n));
     pos = nl + 1 + n;
-    return text;
-  };
-  std::string summary = field();
-  return {std::move(summary), field()};
+  }
+  return out;
+}
+
+std::string reference_text(const std::string& summary, const std::string& csv, const std::optional<SelfCheck>& check) {
+  return "R" + pack_texts({summary, csv, check ? to_json(*check).dump() : std::string("null")});
+}
+
+ReferenceTexts read_reference_text(const std::string& bytes, size_t& pos) {
+  std::vector<std::string> f = unpack_texts(bytes, pos, 3);
+  ReferenceTexts r{std::move(f[0]), std::move(f[1]), std::nullopt};
+  const json check = json::parse(f[2]);
+  if (!check.is_null()) r.self_check = self_check_from_json(check);
+  return r;
 }
 
 // What a reference's task sends back: 'R' and its two cache files' texts, or 'F' and, for a
 // reference that failed, the time and the reason (a result, not an error: its scene's points are
 // recorded as failed).
 std::string failed_reference_text(double time, const std::string& why) {
-  return "F" + pack_texts(json(number(time)).dump(), why);
+  return "F" + pack_texts({json(number(time)).dump(), why});
 }
 // Reads a failed_reference_text at `pos` into ref; false (pos unmoved) for an 'R' entry.
 bool read_failed_reference(const std::string& bytes, size_t& pos, Reference& ref) {
@@ -96,10 +107,10 @@ bool read_failed_reference(const std::string& bytes, size_t& pos, Reference& ref
     return false;
   }
   ++pos;
-  const auto [time, why] = unpack_texts(bytes, pos);
-  const json t = json::parse(time);
+  const std::vector<std::string> f = unpack_texts(bytes, pos, 2);
+  const json t = json::parse(f[0]);
   ref.failure_time = t.is_number() ? t.get<double>() : std::nan("");
-  ref.failure = why;
+  ref.failure = f[1];
   return true;
 }
 
@@ -118,7 +129,9 @@ std::string compute_reference_texts(const Scene& scene) {
   if (record.status == to_string(RunStatus::Failed) || sink.trajectory.size() == 0)
     return failed_reference_text(record.status_time, "the reference run of " + scene.name + " failed at t = " +
                                                          num(record.status_time) + ": " + record.status_detail);
-  return "R" + pack_texts(to_json(record).dump(2) + "\n", csv.text);
+  std::optional<SelfCheck> check;
+  if (scene.run.self_check) check = run_self_check(scene, record, sink.trajectory);
+  return reference_text(to_json(record).dump(2) + "\n", csv.text, check);
 }
 
 // Into the cache (the summary last, so that its presence says the trajectory beside it is
@@ -128,12 +141,15 @@ void store_reference(const fs::path& dir, const Scene& scene, const std::string&
                      Reference& ref) {
   size_t pos = 0;
   if (read_failed_reference(texts, pos, ref)) return;
-  const auto [summary, csv] = unpack_texts(texts, pos);
+  const ReferenceTexts r = read_reference_text(texts, pos);
   fs::create_directories(dir);
-  write_file_atomic((dir / "trajectory.csv").string(), csv);
-  write_file_atomic((dir / "summary.json").string(), summary);
-  const std::string why = reference_from_text(summary, csv, scene, hash, dir.string(), ref.record, ref.trajectory);
+  write_file_atomic((dir / "trajectory.csv").string(), r.csv);
+  write_file_atomic((dir / "summary.json").string(), r.summary);
+  const std::string why = reference_from_text(r.summary, r.csv, scene, hash, dir.string(), ref.record, ref.trajectory);
   if (!why.empty()) throw std::runtime_error("reference of " + scene.name + " does not read back: " + why);
+  // Beside the reference it checks, keyed by that reference's provenance (reference_cache.h).
+  ref.self_check = r.self_check;
+  if (r.self_check) store_self_check(dir, hash, ref.record, *r.self_check);
 }
 
 }  // namespace tippe::sweep_detail

@@ -229,7 +229,15 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<O
   for (size_t i : p.needed) {
     const fs::path dir = out / "reference" / plan.physics_hashes[i];
     // The comparison cache's rule: same physics, same build, complete files.
-    if (load_cached_reference(dir, plan.scenes[i], plan.physics_hashes[i], refs[i].record, refs[i].trajectory))
+    // A reference whose self-check is asked for is cached only with its self-check.
+    const Scene& scene = plan.scenes[i];
+    bool cached = load_cached_reference(dir, scene, plan.physics_hashes[i], refs[i].record, refs[i].trajectory);
+    if (cached && scene.run.self_check) {
+      refs[i].self_check =
+          load_cached_self_check(dir, plan.physics_hashes[i], refs[i].record, self_check_method(scene.run));
+      cached = refs[i].self_check.has_value();
+    }
+    if (cached)
       ++p.cached;
     else
       p.to_compute.push_back(i);
@@ -358,8 +366,8 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
           continue;
         }
         const fs::path dir = out / "reference" / plan.physics_hashes[i];
-        texts += "R" + pack_texts(read_file_text((dir / "summary.json").string()),
-                                  read_file_text((dir / "trajectory.csv").string()));
+        texts += reference_text(read_file_text((dir / "summary.json").string()),
+                                read_file_text((dir / "trajectory.csv").string()), refs[i].self_check);
       }
       return texts;
     });
@@ -369,11 +377,12 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
         size_t pos = 0;
         for (size_t i : prep.needed) {
           if (read_failed_reference(bytes, pos, refs[i])) continue;
-          const auto [summary, csv] = unpack_texts(bytes, pos);
-          const std::string why = reference_from_text(summary, csv, plan.scenes[i], plan.physics_hashes[i],
+          const ReferenceTexts r = read_reference_text(bytes, pos);
+          const std::string why = reference_from_text(r.summary, r.csv, plan.scenes[i], plan.physics_hashes[i],
                                                       "the reference of " + plan.scenes[i].name + " from rank 0",
                                                       refs[i].record, refs[i].trajectory);
           if (!why.empty()) throw std::runtime_error(why);
+          refs[i].self_check = r.self_check;
         }
       } catch (const std::exception& e) {
         error = e.what();

@@ -176,6 +176,7 @@ TEST(SelfCheck, CatchesAReferenceNotConvergedAndCutsTheMetricsAndTheReport) {
   CompareOptions o = quiet({"analytic", "ode"});
   o.out_dir = (dir.path() / "out").string();
   const Comparison c = run_comparison(scene, o);
+  write_report(o.out_dir, to_json(c), /*plots=*/false);  // as `tippe compare` does after the run
   ASSERT_TRUE(c.self_check);
   ASSERT_TRUE(c.self_check->converged_until);
   const double cu = *c.self_check->converged_until;
