@@ -76,7 +76,7 @@ struct RunSpec {
   // the viscous law at large k); all with dense output for event location.
   std::string method = "bulirsch_stoer";
   // The harness runs a second, independent reference over the same scene and says from which
-  // time on the two part (the reference's self-check, harness/compare.h); false skips it.
+  // time on the two part (the reference's self-check, harness/measure/self_check.h); false skips it.
   bool self_check = true;
   // Which of rtol, atol, method, self_check the scene file gave in [run], their older spelling
   // (they are the reference's settings, [engines.analytic]); the reference notes them.

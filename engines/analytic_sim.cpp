@@ -26,7 +26,7 @@ struct AnalyticSettings {
   template <class V>
   void visit(V& v) {
     v("method", method, {"bulirsch_stoer", "dopri5", "rosenbrock4"});
-    // The bounds of run.rtol and run.atol (harness/scene_io.cpp).
+    // The bounds of run.rtol and run.atol (harness/io/scene_io.cpp).
     v("rtol", rtol, 1e-15, 1e-2);
     v("atol", atol, 1e-300, 1.0);
     v("self_check", self_check);

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
 
 namespace tippe {
 
@@ -27,5 +28,19 @@ ProgressMode progress_mode() {
 }
 
 void set_progress_mode(ProgressMode mode) { g_mode.store(static_cast<int>(mode)); }
+
+void ProgressLine::write(std::string line, bool final_line) {
+  if (whole_lines_) {
+    std::fprintf(stderr, "%s\n", line.c_str());
+    std::fflush(stderr);
+    return;
+  }
+  const size_t len = line.size();
+  if (line.size() < width_) line.append(width_ - line.size(), ' ');
+  width_ = len;
+  std::fprintf(stderr, "\r%s", line.c_str());
+  if (final_line) std::fputc('\n', stderr);
+  std::fflush(stderr);
+}
 
 }  // namespace tippe

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <exception>
 #include <cstdio>
 #include <sstream>
 #include <string>
@@ -43,6 +44,18 @@ inline std::string join(const std::vector<std::string>& v, const std::string& se
   std::string out;
   for (const auto& s : v) out += (out.empty() ? "" : sep) + s;
   return out;
+}
+
+// What a caught exception says (its what(), or "unknown exception"): a run that throws is a
+// result with this as its detail.
+inline std::string exception_text(const std::exception_ptr& e) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::exception& x) {
+    return x.what();
+  } catch (...) {
+    return "unknown exception";
+  }
 }
 
 // A dotted key's element: idx("setup", 2) is "setup[2]".

@@ -22,6 +22,7 @@
 
 #include "adapters.h"
 #include "io/interrupt.h"
+#include "io/text.h"
 #include "io/progress.h"
 #include "mass_properties.h"
 #include "io/provenance.h"
@@ -58,16 +59,6 @@ class GuardedSink : public SampleSink {
   SampleSink* inner_;
   bool fatal_;
 };
-
-std::string exception_text(const std::exception_ptr& e) {
-  try {
-    std::rethrow_exception(e);
-  } catch (const std::exception& x) {
-    return x.what();
-  } catch (...) {
-    return "unknown exception";
-  }
-}
 
 // What a run leaves when its simulator could not be built or threw: a record that says so.
 RunRecord failed_record(const Scene& scene, const std::string& engine, const std::string& why,
@@ -142,18 +133,7 @@ class ProgressBoard {
           break;
       }
     }
-    if (mode == ProgressMode::Lines) {
-      std::fprintf(stderr, "%s\n", line.c_str());
-      std::fflush(stderr);
-      return;
-    }
-    // Pads over the tail of a longer previous line.
-    const size_t len = line.size();
-    if (line.size() < width_) line.append(width_ - line.size(), ' ');
-    width_ = len;
-    std::fprintf(stderr, "\r%s", line.c_str());
-    if (final_line) std::fputc('\n', stderr);
-    std::fflush(stderr);
+    out_.write(std::move(line), final_line);
   }
 
  private:
@@ -165,7 +145,7 @@ class ProgressBoard {
   std::vector<std::atomic<double>> t_;
   std::vector<std::atomic<int>> state_;
   std::vector<std::string> why_;
-  size_t width_ = 0;
+  ProgressLine out_{progress_mode() == ProgressMode::Lines};
 };
 
 struct Task {

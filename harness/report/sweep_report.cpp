@@ -252,7 +252,7 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
 // own run on every scene, reported the same way.
 void stability_section(const std::vector<SceneGroup>& scenes, Document& doc) {
   doc.heading(2, "Stability map");
-  doc.para("Every run classified (harness/classify.h): ok; diverged (NaN, energy above 2 E0, G below the floor by more "
+  doc.para("Every run classified (harness/measure/classify.h): ok; diverged (NaN, energy above 2 E0, G below the floor by more "
        "than R/10, speed blow-up); unphysical (energy gain in a dissipative scene, or Jellett's integral drifting "
        "beyond 1e-3 where it must hold); clamped (an engine limit hit, e.g. Bullet's angular-velocity clamp); failed "
        "(the engine refused the scene or threw); contact_lost; with the time it happened. \"regime differs\": the run "

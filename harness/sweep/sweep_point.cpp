@@ -8,6 +8,7 @@
 
 #include "registry.h"
 #include "io/interrupt.h"
+#include "io/text.h"
 #include "io/provenance.h"
 #include "measure/classify.h"
 #include "records/records.h"
@@ -22,16 +23,6 @@ json settings_object(const SettingsList& s) {
   json o = json::object();
   for (const auto& [k, v] : s) o[k] = v;
   return o;
-}
-
-std::string exception_text(const std::exception_ptr& e) {
-  try {
-    std::rethrow_exception(e);
-  } catch (const std::exception& x) {
-    return x.what();
-  } catch (...) {
-    return "unknown exception";
-  }
 }
 
 }  // namespace

@@ -73,17 +73,7 @@ class SweepProgress {
       const double left = estimate_left(elapsed);
       line += std::isfinite(left) ? " | ~" + clock_text(left) + " left" : " | estimating";
     }
-    if (lines_) {
-      std::fprintf(stderr, "%s\n", line.c_str());
-      std::fflush(stderr);
-      return;
-    }
-    const size_t len = line.size();
-    if (line.size() < width_) line.append(width_ - line.size(), ' ');
-    width_ = len;
-    std::fprintf(stderr, "\r%s", line.c_str());
-    if (final_line) std::fputc('\n', stderr);
-    std::fflush(stderr);
+    out_.write(std::move(line), final_line);
   }
 
  private:
@@ -141,7 +131,7 @@ class SweepProgress {
   std::vector<bool> finished_;
   size_t done_ = 0;
   std::map<size_t, std::vector<std::pair<double, double>>> samples_;  // setup -> (weight, wall)
-  size_t width_ = 0;
+  ProgressLine out_{lines_};
 };
 
 

@@ -19,6 +19,7 @@
 #include "support/process.h"
 #include "support/records.h"
 #include "report/sweep_analysis.h"
+#include "support/fixtures.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
@@ -26,8 +27,8 @@ using nlohmann::json;
 
 namespace {
 
-const std::string kSource = std::string(TIPPE_SOURCE_DIR);
-const std::string kBinary = std::string(TIPPE_BINARY_DIR) + "/tippe";
+const std::string& kSource = fixtures::kSourceDir;
+const std::string& kBinary = fixtures::kTippeBinary;
 const std::string kSmoke = kSource + "/harness/sweeps/smoke.toml";
 
 // ---- running the binary -----------------------------------------------------------------------
