@@ -322,6 +322,17 @@ std::string percent_late(double rel) {
   return fmt(100 * std::abs(rel), "%.3g") + " % " + (rel > 0 ? "late" : "early");
 }
 
+// The caveat for an engine's event past the end of the reference's converged window (its
+// self-check): the verdict stands on a reference that is not trusted there.
+std::string past_window(const json& metrics, const json& summary) {
+  if (!has_number(metrics, "reference_converged_until") || !has_number(summary, "inversion_time")) return "";
+  const double until = num(metrics, "reference_converged_until");
+  if (!(num(summary, "inversion_time") > until)) return "";
+  return "; it inverts after t = " + fmt(until, "%.6g") +
+         ", where the reference's self-check says the reference is no longer converged, so this rests on an "
+         "unconverged reference";
+}
+
 }  // namespace
 
 std::vector<std::string> verdict_sentences(const json& c) {
@@ -346,7 +357,7 @@ std::vector<std::string> verdict_sentences(const json& c) {
       t += std::isfinite(rel) ? percent_late(rel) + " (t = " + inv + " against the reference's " + ref_inv + ")"
                               : "at t = " + inv + " against the reference's " + ref_inv +
                                     " (error not measured: " + str(m, "inversion_event") + ")";
-      t += early + ".";
+      t += past_window(m, s) + early + ".";
     } else if (ref_inverts) {
       t += ok ? "does not invert by the end of its run (t = " + run_time_text(s) + ") while the reference inverts at t = " +
                     ref_inv + ": the wrong regime, no inversion time to compare."
@@ -354,7 +365,7 @@ std::vector<std::string> verdict_sentences(const json& c) {
                     ": neither its regime nor an inversion time can be compared.";
     } else if (inverts) {
       t += "inverts at t = " + inv + " while the reference does not invert to t = " + run_time_text(ref) +
-           ": the wrong regime, no inversion time to compare" + early + ".";
+           ": the wrong regime, no inversion time to compare" + past_window(m, s) + early + ".";
     } else {
       t += ok ? "does not invert to t = " + run_time_text(s) +
                     ", like the reference (the reference's regime); there is no inversion time to compare."

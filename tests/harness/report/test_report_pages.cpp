@@ -143,6 +143,22 @@ TEST(ReportVerdict, RollingLikeTheReferenceAndEndedEarly) {
   EXPECT_NE(v[1].find("its run ended early (diverged at t = 0.5) without inverting"), std::string::npos) << v[1];
 }
 
+TEST(ReportVerdict, AnInversionPastTheReferencesConvergedWindowSaysSo) {
+  TempDir dir{"tippe-pages"};
+  json c = make_comparison(dir.path());
+  // The reference's self-check parts at t = 1.02: ode's inversion at 1.05 rests on an unconverged
+  // reference, and its sentence says so; an event inside the window carries no such caveat.
+  c["engines"][0]["metrics"]["reference_converged_until"] = 1.02;
+  auto v = verdict_sentences(c);
+  EXPECT_NE(v[0].find("5 % late (t = 1.05 against the reference's 1); it inverts after t = 1.02, where the "
+                      "reference's self-check says the reference is no longer converged"),
+            std::string::npos)
+      << v[0];
+  c["engines"][0]["metrics"]["reference_converged_until"] = 1.5;
+  v = verdict_sentences(c);
+  EXPECT_EQ(v[0], "ode: inverts like the reference, 5 % late (t = 1.05 against the reference's 1).") << v[0];
+}
+
 TEST(ReportPage, OpensWithTheVerdictAndLinksTheDataAndTheIndex) {
   TempDir dir{"tippe-pages"};
   const json c = make_comparison(dir.path());
