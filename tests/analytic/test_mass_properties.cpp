@@ -219,7 +219,7 @@ TEST(MassProperties, SeedReproducesPrintedClosedForms) {
 }
 
 TEST(MassProperties, SeedMatchesShellQuadrature) {
-  // Tolerance: the brief's 1e-10; tanh-sinh at 1e-14 termination delivers ~1e-14 on these
+  // Tolerance: the 1e-10 the mass properties are required to; tanh-sinh at 1e-14 termination delivers ~1e-14 on these
   // piecewise-smooth integrands once the kinks are integration ends.
   double worst = 0;
   for (const BodyGeometry& b : geometries(MassModel::Seed))
@@ -304,7 +304,7 @@ TEST(MassProperties, ToyTop) {
     RecordProperty(std::string(name) + "_alpha", std::to_string(m.com_offset / R));
     RecordProperty(std::string(name) + "_A_over_C", std::to_string(m.inertia_transverse / m.inertia_axial));
   }
-  // The brief's expectations for the seed convention ("alpha near 0.13, A/C near 1.0").
+  // The values expected of the seed convention ("alpha near 0.13, A/C near 1.0").
   EXPECT_NEAR(seed.com_offset / R, 0.13, 0.01);
   EXPECT_NEAR(seed.inertia_transverse / seed.inertia_axial, 1.0, 0.02);
   EXPECT_TRUE(inversion_possible(seed, R));

@@ -60,7 +60,7 @@ void expect_same_sequence(const std::string& rel, bool until_lift, bool names_wh
                   rtol, ev.size(), until_lift ? " to the first lift" : "", worst);
       ASSERT_EQ(ev.size(), base.size()) << method << " rtol " << rtol;
       // Event times carry the error of the state they are found on. At rtol <= 1e-10 the
-      // brief's 1e-6 (measured: at most 1.5e-7, rosenbrock4 and bulirsch_stoer at 1e-10). At
+      // required 1e-6 (measured: at most 1.5e-7, rosenbrock4 and bulirsch_stoer at 1e-10). At
       // rtol 1e-8 the state itself is off by ~1e-8 of its size per phase and the cascade's
       // impacts compound it (measured: 1.1e-5 on source_dimensionless, 1.5e-5 on
       // tilt_near_pi); 5e-5 is three times that and below the shortest interval between two
