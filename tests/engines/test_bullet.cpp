@@ -21,40 +21,24 @@ namespace {
 
 using namespace fixtures;
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
 bool same_bits(const Observation& a, const Observation& b) {
-  bool eq = same_bits(a.state.t, b.state.t) && same_bits(a.normal_force, b.normal_force) &&
+  bool eq = bit_equal(a.state.t, b.state.t) && bit_equal(a.normal_force, b.normal_force) &&
             a.engine_contact_valid == b.engine_contact_valid;
   for (int i = 0; i < 3; ++i)
-    eq = eq && same_bits(a.state.p_WG[i], b.state.p_WG[i]) && same_bits(a.state.v_WG[i], b.state.v_WG[i]) &&
-         same_bits(a.state.w_B[i], b.state.w_B[i]) && same_bits(a.p_WC_engine[i], b.p_WC_engine[i]);
-  for (int i = 0; i < 4; ++i) eq = eq && same_bits(a.state.q_WB.coeffs()[i], b.state.q_WB.coeffs()[i]);
+    eq = eq && bit_equal(a.state.p_WG[i], b.state.p_WG[i]) && bit_equal(a.state.v_WG[i], b.state.v_WG[i]) &&
+         bit_equal(a.state.w_B[i], b.state.w_B[i]) && bit_equal(a.p_WC_engine[i], b.p_WC_engine[i]);
+  for (int i = 0; i < 4; ++i) eq = eq && bit_equal(a.state.q_WB.coeffs()[i], b.state.q_WB.coeffs()[i]);
   return eq;
 }
 
 // Both entry points must throw std::invalid_argument naming engines.bullet.KEY.
 void expect_setting_error(const Scene& scene, const std::string& key) {
   const std::string want = "engines.bullet." + key;
-  try {
-    validate_bullet_settings(scene);
-    ADD_FAILURE() << "validate_bullet_settings accepted " << want;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
-  }
-  try {
-    make_simulator("bullet", scene);
-    ADD_FAILURE() << "make_simulator accepted " << want;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
-  }
+  expect_refusal_naming([&] { validate_bullet_settings(scene); }, "validate_bullet_settings", want);
+  expect_refusal_naming([&] { make_simulator("bullet", scene); }, "make_simulator", want);
 }
 
-std::string setting(const Simulator& sim, const std::string& key) {
-  for (const auto& kv : sim.settings())
-    if (kv.first == key) return kv.second;
-  return "<missing>";
-}
+std::string setting(const Simulator& sim, const std::string& key) { return setting_value(sim.settings(), key); }
 
 TEST(Bullet, MassAndShapesReadBackEqualScene) {
   const Scene scene = dimensionless_scene();

@@ -25,31 +25,13 @@ namespace {
 
 using namespace fixtures;
 
-
-
-
 // Expects validate_mujoco_settings, make_mujoco_simulator and mujoco_mjcf to throw
 // std::invalid_argument whose message names engines.mujoco.KEY.
 void expect_setting_error(const Scene& scene, const std::string& key) {
   const std::string want = "engines.mujoco." + key;
-  try {
-    validate_mujoco_settings(scene);
-    ADD_FAILURE() << "validate_mujoco_settings accepted " << want;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
-  }
-  try {
-    make_mujoco_simulator(scene);
-    ADD_FAILURE() << "make_mujoco_simulator accepted " << want;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
-  }
-  try {
-    mujoco_mjcf(scene);
-    ADD_FAILURE() << "mujoco_mjcf accepted " << want;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
-  }
+  expect_refusal_naming([&] { validate_mujoco_settings(scene); }, "validate_mujoco_settings", want);
+  expect_refusal_naming([&] { make_mujoco_simulator(scene); }, "make_mujoco_simulator", want);
+  expect_refusal_naming([&] { mujoco_mjcf(scene); }, "mujoco_mjcf", want);
 }
 
 TEST(Mujoco, MassReadBackEqualsScene) {

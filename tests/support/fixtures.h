@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <functional>
+#include <stdexcept>
 #include <string>
 
 #include "scene.h"
@@ -95,6 +97,17 @@ inline std::string setting_value(const SettingsList& list, const std::string& ke
   for (const auto& kv : list)
     if (kv.first == key) return kv.second;
   return "<missing>";
+}
+
+// Expects `call` (an engine's entry point, named `what` in the failure) to throw
+// std::invalid_argument whose message names `want` (e.g. "engines.ode.timestep").
+inline void expect_refusal_naming(const std::function<void()>& call, const std::string& what, const std::string& want) {
+  try {
+    call();
+    ADD_FAILURE() << what << " accepted " << want;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace tippe::fixtures

@@ -25,7 +25,6 @@ namespace {
 
 using namespace tippe::fixtures;
 
-
 std::string replace_all(std::string text, const std::string& from, const std::string& to) {
   for (size_t pos = 0; (pos = text.find(from, pos)) != std::string::npos; pos += to.size()) text.replace(pos, from.size(), to);
   return text;

@@ -23,10 +23,6 @@ namespace {
 
 using namespace tippe::fixtures;
 
-
-
-
-
 std::string load_error(const std::string& path, const std::vector<std::string>& overrides = {}) {
   try {
     load_scene(path, overrides);
