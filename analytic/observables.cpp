@@ -95,22 +95,34 @@ double tilt(const Quat& q_WB) {
   return std::atan2(std::hypot(e_Z.x(), e_Z.y()), e_Z.z());
 }
 
-Observation observe_kinematics(const BodyModel& m, const BodyState& x) {
+namespace {
+
+// The observables of x with the contact quantities taken on surface `on`.
+Observation observe_on(const BodyModel& m, const BodyState& x, Surface on) {
   Observation o;
   o.state = x;
   o.theta = tilt(x.q_WB);
-  const Surface low = lower_surface(m, x.q_WB);
-  o.surface = low;
-  const Vec3 R_C_W = contact_offset_W(m, x.q_WB, low);
+  o.surface = on;
+  const Vec3 R_C_W = contact_offset_W(m, x.q_WB, on);
   o.p_WC = x.p_WG + R_C_W;
   const Vec3 w_W = x.q_WB * x.w_B;
   const Vec3 v_C = x.v_WG + w_W.cross(R_C_W);
   o.slip_speed = std::hypot(v_C.x(), v_C.y());
   o.energy = energy(m, x);
-  o.jellett = jellett(m, x, low);
+  o.jellett = jellett(m, x, on);
   // Latitude of the ball point under O measured from the south pole -e_Z.
   const Vec3 down_B = x.q_WB.conjugate() * (-Vec3::UnitZ());
   o.contact_latitude = std::atan2(std::hypot(down_B.x(), down_B.y()), -down_B.z());
+  return o;
+}
+
+}  // namespace
+
+Observation observe_kinematics(const BodyModel& m, const BodyState& x) { return observe_on(m, x, lower_surface(m, x.q_WB)); }
+
+Observation observe_kinematics_on_both(const BodyModel& m, const BodyState& x) {
+  Observation o = observe_on(m, x, Surface::Ball);
+  o.surface = Surface::Both;
   return o;
 }
 

@@ -29,7 +29,11 @@ double surface_gap(const BodyModel& m, const BodyState& x, Surface s);
 double energy(const BodyModel& m, const BodyState& x);
 double jellett(const BodyModel& m, const BodyState& x, Surface s);
 double tilt(const Quat& q_WB);
-// Fills every kinematic observable of x; force fields are left for the caller.
+// Fills every kinematic observable of x; force fields are left for the caller. The contact
+// quantities (point, slip, Jellett's J, surface) are those of the lower surface.
 Observation observe_kinematics(const BodyModel& m, const BodyState& x);
+// The same with ball and stem on the floor together (surface Both), as the reference reports its
+// two-contact phase: the contact quantities are the ball's.
+Observation observe_kinematics_on_both(const BodyModel& m, const BodyState& x);
 
 }  // namespace tippe

@@ -25,7 +25,7 @@ const char* to_string(Surface s);
 struct Observation {
   BodyState state;
   double theta = 0.0;              // tilt: angle between e_Z and the lab vertical
-  Surface surface = Surface::Ball; // geometric: the lower of ball and stem tip (Both at a tie)
+  Surface surface = Surface::Ball; // the lower of ball and stem tip; Both while the simulator has both on the floor
   Vec3 p_WC = Vec3::Zero();        // geometric floor contact point (lowest point of the lower surface)
   bool engine_contact_valid = false;
   Vec3 p_WC_engine = Vec3::Zero(); // contact point as the engine reports it

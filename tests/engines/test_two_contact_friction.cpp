@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "records/records.h"
 #include "registry.h"
@@ -37,6 +39,46 @@ TEST_P(TwoContactFriction, EnergyLostWithBallAndStemDownMatchesTheReference) {
   EXPECT_GT(energy_lost(ref), 0.8) << "the scene no longer tests two contacts";
   EXPECT_NEAR(energy_lost(run), energy_lost(ref), 0.03)
       << engine << " loses " << energy_lost(run) << " of E0, the reference " << energy_lost(ref);
+}
+
+// A sample taken while the engine has ball and stem on the floor is on both surfaces, as the
+// reference's samples are in its two-contact phase: Jellett's J is conserved on one surface only,
+// so the J check (SampleSummary) must not run across such samples. Labelled by the lower surface
+// alone, the two-contact phase of this scene (0.334 to 0.391 s in the reference) was checked as a
+// run on the stem, and every engine was classed unphysical for a J "drift" there (0.34 to 0.40
+// of J at this step; beyond the 1e-3 tolerance within 2 ms of the phase's start), at every step
+// down to 1e-6. The engine's own "switch" events say when it has both contacts; every
+// sample between a switch to "both" and the next switch must say Both, and the J drift the
+// record keeps for the stem must then be the drift of its runs on the stem alone: below the J
+// check's tolerance (1e-3; measured at this step 1.7e-5 (DART) to 4.0e-4 (Bullet), whose drift grows
+// to 9.4e-4 at 1e-5).
+struct SurfaceSink : SampleSink {
+  std::vector<std::pair<double, Surface>> samples;
+  void write(const Observation& o) override { samples.emplace_back(o.state.t, o.surface); }
+};
+TEST_P(TwoContactFriction, SamplesWithBallAndStemDownAreOnBoth) {
+  const std::string engine = GetParam();
+  const Scene scene = load_scene(kScene, {"engines." + engine + ".timestep=1e-4", "run.duration=0.45"});
+  SurfaceSink sink;
+  const RunRecord run = run_scene(scene, engine, &sink);
+  ASSERT_EQ(run.status, "ok") << run.status_detail;
+  std::vector<std::pair<double, bool>> switches;  // time, to both
+  for (const Event& e : run.events)
+    if (e.name == "switch") switches.emplace_back(e.time, e.detail.size() >= 4 && e.detail.compare(e.detail.size() - 4, 4, "both") == 0);
+  int on_both = 0, mislabelled = 0;
+  for (const auto& [t, surface] : sink.samples) {
+    bool both = false;  // the engine's contacts at t: those of the last switch at or before t
+    for (const auto& [ts, to_both] : switches)
+      if (ts <= t + 1e-12) both = to_both;
+    on_both += both;
+    mislabelled += both != (surface == Surface::Both);
+  }
+  std::printf("%s: %d of %zu samples with ball and stem down, %d mislabelled; J drift on the stem %.3g\n", engine.c_str(),
+              on_both, sink.samples.size(), mislabelled, run.jellett_drift_stem.value_or(-1));
+  EXPECT_GT(on_both, 10) << "the scene no longer has a two-contact phase";
+  EXPECT_EQ(mislabelled, 0);
+  ASSERT_TRUE(run.jellett_drift_stem.has_value());
+  EXPECT_LT(*run.jellett_drift_stem, 1e-3);
 }
 
 // Engine-native laws act at the contacts the engine makes: a top put down at the switching tilt,
