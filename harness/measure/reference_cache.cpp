@@ -40,7 +40,10 @@ std::optional<SelfCheck> load_cached_self_check(const fs::path& dir, const std::
     const json j = json::parse(read_file_text((dir / "self_check.json").string()));
     if (j.at("format") != "tippe-self-check-1" || j.at("key") != self_check_key(hash, reference, plan))
       return std::nullopt;
-    return self_check_from_json(j.at("self_check"));
+    SelfCheck sc = self_check_from_json(j.at("self_check"));
+    // The check itself must be the one its key names (a file edited or pieced together is not).
+    if (sc.method != plan.method || sc.rtol != plan.rtol || sc.atol != plan.atol) return std::nullopt;
+    return sc;
   } catch (const std::exception&) {
     return std::nullopt;  // absent, partial or from elsewhere: run the check again
   }

@@ -160,16 +160,21 @@ struct SweepOptions {
 
 struct SweepOutcome {
   size_t points = 0, skipped = 0, ran = 0;  // skipped: finished by an earlier run of the same DIR
-  size_t references_cached = 0;
+  size_t references_cached = 0;  // read from OUT/reference/ (with or without their self-check)
+  // Computed now: whole references (the reference run, and its self-check when asked for), and
+  // the self-check alone of a cached reference that had none (an entry written before the
+  // self-check existed, or whose self_check.json was lost, cut short or made for another run).
+  size_t references_computed = 0, self_checks_computed = 0;
   size_t partial_bytes_dropped = 0;
   double wall_seconds = 0;
 };
 
 // Runs every point of `plan` (or of options.shard's share) not yet in OUT/records.jsonl, on
 // `jobs` threads, appending one fsynced line per finished point; then writes the report. Layout
-// of OUT: sweep.json (the sweep file, its hash, the plan hash and the shard), records.jsonl, reference/<physics_hash>/{summary.json,
-// trajectory.csv}, report.md, index.html, *.svg. Throws SweepInputError before anything is
-// written; an engine that diverges or throws is a point with that status, not an error.
+// of OUT: sweep.json (the sweep file, its hash, the plan hash and the shard), records.jsonl,
+// reference/<physics_hash>/{summary.json, trajectory.csv, self_check.json}, report.md,
+// index.html, *.svg. Throws SweepInputError before anything is written; an engine that diverges
+// or throws is a point with that status, not an error.
 SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& options);
 // The same over a farm of processes (every rank calls it; task_farm.h): the coordinator does all
 // of the above that touches OUT; each missing reference is computed by one worker and shared with

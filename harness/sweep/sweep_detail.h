@@ -61,6 +61,14 @@ std::string compute_reference_texts(const Scene& scene);
 // from the very texts every other rank will read.
 void store_reference(const std::filesystem::path& dir, const Scene& scene, const std::string& hash,
                      const std::string& texts, Reference& ref);
+// The self-check alone of a reference read from the cache without one (reference_cache.h): the
+// second method's run and the comparison with `ref`, on whichever process the task lands (every
+// rank holds the reference by then); to_json(SelfCheck) as text. The reference is not run again.
+std::string compute_self_check_text(const Scene& scene, const Reference& ref);
+// That text into memory (ref.self_check) and beside the reference in the cache dir; throws
+// std::runtime_error naming the scene when it does not read back.
+void store_self_check_text(const std::filesystem::path& dir, const Scene& scene, const std::string& hash,
+                           const std::string& text, Reference& ref);
 
 // Runs one point `repeats` times on the calling thread into its record.
 SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Reference& ref);

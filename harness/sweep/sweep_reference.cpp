@@ -1,4 +1,4 @@
-// The reference of each scene of a sweep: computed once on any rank, cached in OUT/reference/, shared with every rank.
+// The reference of each scene of a sweep (or its self-check alone): computed once on any rank, cached in OUT/reference/, shared with every rank.
 #include "sweep/sweep_detail.h"
 
 #include <cmath>
@@ -150,6 +150,20 @@ void store_reference(const fs::path& dir, const Scene& scene, const std::string&
   // Beside the reference it checks, keyed by that reference's provenance (reference_cache.h).
   ref.self_check = r.self_check;
   if (r.self_check) store_self_check(dir, hash, ref.record, *r.self_check);
+}
+
+std::string compute_self_check_text(const Scene& scene, const Reference& ref) {
+  return to_json(run_self_check(scene, ref.record, ref.trajectory)).dump();
+}
+
+void store_self_check_text(const fs::path& dir, const Scene& scene, const std::string& hash, const std::string& text,
+                           Reference& ref) {
+  try {
+    ref.self_check = self_check_from_json(json::parse(text));
+  } catch (const std::exception& e) {
+    throw std::runtime_error("self-check of the reference of " + scene.name + " does not read back: " + e.what());
+  }
+  store_self_check(dir, hash, ref.record, *ref.self_check);
 }
 
 }  // namespace tippe::sweep_detail

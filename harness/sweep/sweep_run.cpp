@@ -70,6 +70,7 @@ struct Prepared {
   std::vector<size_t> todo;        // indices into plan.points, in the order they are handed out
   std::vector<size_t> needed;      // scenes with a point in todo
   std::vector<size_t> to_compute;  // of those, the ones not in the cache
+  std::vector<size_t> to_check;    // of those, the ones in the cache without the self-check asked for
   size_t share = 0, skipped = 0, cached = 0, partial_bytes = 0;
 };
 
@@ -84,6 +85,7 @@ std::string encode(const Prepared& p) {
   list(p.todo);
   list(p.needed);
   list(p.to_compute);
+  list(p.to_check);
   return ss.str();
 }
 
@@ -100,6 +102,7 @@ Prepared decode(const std::string& bytes) {
   list(p.todo);
   list(p.needed);
   list(p.to_compute);
+  list(p.to_check);
   if (!ss) throw std::runtime_error("MPI: the coordinator's plan message is cut short");
   return p;
 }
@@ -228,19 +231,20 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<O
       p.needed.push_back(i);
   for (size_t i : p.needed) {
     const fs::path dir = out / "reference" / plan.physics_hashes[i];
-    // The comparison cache's rule: same physics, same build, complete files.
-    // A reference whose self-check is asked for is cached only with its self-check.
+    // The comparison cache's rule: same physics, same build, complete files. A cached reference
+    // without the self-check asked for (absent, unreadable, or made for another reference or
+    // method: load_cached_self_check) is kept, and only its self-check runs, as in a comparison.
     const Scene& scene = plan.scenes[i];
-    bool cached = load_cached_reference(dir, scene, plan.physics_hashes[i], refs[i].record, refs[i].trajectory);
-    if (cached && scene.run.self_check) {
+    if (!load_cached_reference(dir, scene, plan.physics_hashes[i], refs[i].record, refs[i].trajectory)) {
+      p.to_compute.push_back(i);
+      continue;
+    }
+    ++p.cached;
+    if (scene.run.self_check) {
       refs[i].self_check =
           load_cached_self_check(dir, plan.physics_hashes[i], refs[i].record, self_check_method(scene.run));
-      cached = refs[i].self_check.has_value();
+      if (!refs[i].self_check) p.to_check.push_back(i);
     }
-    if (cached)
-      ++p.cached;
-    else
-      p.to_compute.push_back(i);
   }
   return p;
 }
@@ -343,6 +347,8 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
   outcome.points = prep.share;
   outcome.skipped = prep.skipped;
   outcome.references_cached = prep.cached;
+  outcome.references_computed = prep.to_compute.size();
+  outcome.self_checks_computed = prep.to_check.size();
   outcome.partial_bytes_dropped = prep.partial_bytes;
 
   // 2. Each missing reference is computed once, wherever a worker is free; the coordinator caches it.
@@ -391,6 +397,42 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
     error = first_error(farm, error);
     if (!error.empty()) throw std::runtime_error(error);
   }
+
+  // 4. The self-check alone of each cached reference without one, wherever a worker is free (every
+  // rank holds the reference now); the coordinator caches it beside the reference and shares it.
+  if (!prep.to_check.empty()) {
+    if (farm.coordinator() && o.progress)
+      std::fprintf(stderr, "[sweep] checking %zu cached reference(s): their self-check only\n", prep.to_check.size());
+    farm.run(
+        prep.to_check.size(),
+        [&](size_t k) { return compute_self_check_text(plan.scenes[prep.to_check[k]], refs[prep.to_check[k]]); },
+        [&](size_t k, std::string&& text) {
+          const size_t i = prep.to_check[k];
+          store_self_check_text(out / "reference" / plan.physics_hashes[i], plan.scenes[i], plan.physics_hashes[i],
+                                text, refs[i]);
+        });
+    if (farm.distributed()) {
+      const std::string bytes = from_coordinator(farm, [&] {
+        std::vector<std::string> texts;
+        for (size_t i : prep.to_check) texts.push_back(to_json(*refs[i].self_check).dump());
+        return pack_texts(texts);
+      });
+      std::string error;
+      if (!farm.coordinator()) {
+        try {
+          size_t pos = 0;
+          const std::vector<std::string> texts = unpack_texts(bytes, pos, prep.to_check.size());
+          for (size_t k = 0; k < texts.size(); ++k)
+            refs[prep.to_check[k]].self_check = self_check_from_json(json::parse(texts[k]));
+        } catch (const std::exception& e) {
+          error = std::string("the self-checks from rank 0: ") + e.what();
+        }
+      }
+      error = first_error(farm, error);
+      if (!error.empty()) throw std::runtime_error(error);
+    }
+  }
+
   for (size_t i : prep.needed)
     if (refs[i].failure.empty()) refs[i].summary = reference_summary(plan.scenes[i], refs[i]);
   if (farm.coordinator())
@@ -401,7 +443,7 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
         std::fprintf(stderr, "tippe: warning: %s; its %zu point(s) are recorded as failed\n", refs[i].failure.c_str(), n);
       }
 
-  // 4. The points: each runs once, on some worker; the coordinator appends its line.
+  // 5. The points: each runs once, on some worker; the coordinator appends its line.
   if (!prep.todo.empty()) {
     std::unique_ptr<RecordAppender> appender;
     std::unique_ptr<SweepProgress> progress;

@@ -60,6 +60,8 @@ SweepOutcome run_search_sweep(SweepPlan plan, const SweepOptions& o, TaskFarm& f
     total.ran += r.ran;
     total.partial_bytes_dropped += r.partial_bytes_dropped;
     if (first) total.references_cached = r.references_cached;
+    total.references_computed += r.references_computed;
+    total.self_checks_computed += r.self_checks_computed;
     first = false;
   }
   SweepOptions last = o;

@@ -266,10 +266,13 @@ TEST(SelfCheck, IsCachedWithTheReferenceAndNeverAssumed) {
   EXPECT_EQ(second.engines[0].metrics.reference_converged_until, first.self_check->converged_until);
 
   // A cached reference without its self-check (an entry from before it, or one whose check was
-  // lost) has the check run again, not assumed.
+  // lost) has the check run again, not assumed, and only the check: the reference's summary (its
+  // own CPU time and date) stays as it was.
+  const std::string summary = slurp(entry / "summary.json");
   fs::remove(entry / "self_check.json");
   const Comparison third = run_comparison(scene, o);
   EXPECT_TRUE(third.reference_cached);
+  EXPECT_TRUE(slurp(entry / "summary.json") == summary) << "the cached reference was run again";
   ASSERT_TRUE(third.self_check);
   EXPECT_FALSE(third.self_check_cached);
   EXPECT_EQ(third.self_check->converged_until, first.self_check->converged_until);

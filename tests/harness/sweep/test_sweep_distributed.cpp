@@ -18,65 +18,19 @@
 #include "support/files.h"
 #include "support/process.h"
 #include "support/records.h"
+#include "support/sweep_runs.h"
 #include "report/sweep_analysis.h"
 #include "support/fixtures.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
+using namespace tippe::sweep_runs;
 
 namespace {
 
 const std::string& kSource = fixtures::kSourceDir;
-const std::string& kBinary = fixtures::kTippeBinary;
 const std::string kSmoke = kSource + "/harness/sweeps/smoke.toml";
-
-// ---- running the binary -----------------------------------------------------------------------
-
-// The command with stdout and stderr into `log`; its exit status (-1: ended by a signal).
-int run(const std::vector<std::string>& argv, const fs::path& log) {
-  return wait_process(spawn_process(argv, log, log)).code;
-}
-
-std::vector<std::string> tippe_sweep(std::vector<std::string> args) {
-  args.insert(args.begin(), {kBinary, "sweep"});
-  args.push_back("--no-plots");
-  return args;
-}
-
-// ---- records ----------------------------------------------------------------------------------
-
-std::vector<json> lines_of(const fs::path& records) {
-  std::vector<json> out;
-  std::ifstream in(records);
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty()) out.push_back(json::parse(line));
-  return out;
-}
-
-// point id -> record without timings; a point written twice fails the test.
-std::map<std::string, json> records_by_id(const fs::path& dir) {
-  std::map<std::string, json> out;
-  for (const json& r : lines_of(dir / "records.jsonl")) {
-    const std::string id = r.at("point_id");
-    EXPECT_TRUE(out.emplace(id, without_timings(r)).second) << dir << ": point " << id << " written twice";
-  }
-  return out;
-}
-
-// The same points with the same records, a difference named by point and field.
-void expect_same_records(const fs::path& expected_dir, const fs::path& actual_dir) {
-  const auto a = records_by_id(expected_dir), b = records_by_id(actual_dir);
-  ASSERT_EQ(a.size(), b.size()) << expected_dir << " vs " << actual_dir;
-  for (const auto& [id, ra] : a) {
-    auto it = b.find(id);
-    ASSERT_NE(it, b.end()) << actual_dir << " lacks point " << id;
-    if (ra == it->second) continue;
-    for (auto f = ra.begin(); f != ra.end(); ++f)
-      EXPECT_EQ(f.value(), it->second.value(f.key(), json())) << "point " << id << " field " << f.key();
-    FAIL() << "point " << id << " differs";
-  }
-}
 
 // One local run of the smoke sweep, shared by the tests that compare against it.
 const fs::path& local_smoke() {
@@ -414,28 +368,6 @@ TEST(SweepShards, GridAndCategoricalLaddersShardMergeAndResumeAsOneRun) {
 }
 
 #ifdef TIPPE_HAVE_MPI
-
-// Where mpirun is; "" when not on PATH.
-std::string mpirun_path() {
-  const char* path = std::getenv("PATH");
-  std::stringstream ss(path ? path : "");
-  for (std::string dir; std::getline(ss, dir, ':');)
-    if (!dir.empty() && ::access((fs::path(dir) / "mpirun").c_str(), X_OK) == 0) return (fs::path(dir) / "mpirun").string();
-  return "";
-}
-
-// mpirun -np N [--oversubscribe] tippe sweep ARGS. Open MPI refuses root without its two
-// allow-run-as-root variables (CI runs as root), and more ranks than cores without --oversubscribe.
-std::vector<std::string> mpirun_sweep(int np, std::vector<std::string> args) {
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-  std::vector<std::string> argv = {mpirun_path(), "--oversubscribe", "-np", std::to_string(np)};
-  for (const std::string& a : tippe_sweep(std::move(args))) argv.push_back(a);
-  return argv;
-}
-
-// The build found MPI, so mpirun must be there too (openmpi-bin): its absence is a failure.
-#define REQUIRE_MPIRUN() ASSERT_FALSE(mpirun_path().empty()) << "MPI was found at build time but mpirun is not on PATH"
 
 TEST(SweepMpi, TwoAndThreeRanksGiveTheRecordsOfOneJob) {
   REQUIRE_MPIRUN();
