@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tippe {
 
@@ -118,6 +119,38 @@ ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode&
   if (dydt)
     for (size_t i = 0; i < d0.size(); ++i) (*dydt)[i] = (1 - f) * d0[i] + f * d1[i];
   return out;
+}
+
+void ContactDynamics::slip_scale(const StateVector& y, const ContactMode& mode, StateVector& scale) const {
+  scale.fill(std::numeric_limits<double>::infinity());
+  if (c_.friction != FrictionLaw::Coulomb) return;
+  for (int s = 0; s < 2; ++s) {
+    const ContactSlot& slot = mode.slot[s];
+    if (!slot.active || slot.stick || slot.slip_start || slot.graze) continue;
+    // The slip the direction is taken from: the horizontal velocity at C, or the coupled
+    // law's generalised slip (the same quantities as evaluate_fixed()).
+    auto slip_of = [&](const StateVector& yy) {
+      const BodyState x = unpack(yy, 0.0);
+      if (coupled()) return coupled_slip(x, s);
+      Vec3 v = contact_velocity(x, s);
+      v.z() = 0.0;
+      return v;
+    };
+    const double size = slip_of(y).norm();
+    if (!(size > 0.0) || (coupled() && !(size > slot.coupled_floor))) continue;
+    // ds/dy_j by central differences: s is linear in v and w and smooth in q on the scale of
+    // a radian, so a step of cbrt(eps) of the component (or of 1) gives it to ~1e-10, far
+    // more than a bound needs.
+    const double cbrt_eps = std::cbrt(std::numeric_limits<double>::epsilon());
+    for (size_t j = 0; j < y.size(); ++j) {
+      StateVector yp = y, ym = y;
+      yp[j] = y[j] + cbrt_eps * std::max(std::abs(y[j]), 1.0);
+      const double h = yp[j] - y[j];
+      ym[j] = y[j] - h;
+      const double rate = (slip_of(yp) - slip_of(ym)).norm() / (2 * h);
+      if (rate > 0.0) scale[j] = std::min(scale[j], size / rate);
+    }
+  }
 }
 
 Vec3 ContactDynamics::slip_rate(const StateVector& y, const StateVector& dy, int s) const {

@@ -125,6 +125,15 @@ class ContactDynamics {
   // projection in the mass metric, so it can only remove energy (positions unchanged).
   BodyState stop_contact(const BodyState& x, int slot, bool spin) const;
 
+  // For a Jacobian by differences: per state component j, the change of y_j over which the
+  // friction direction of a sliding Coulomb contact of `mode` turns by O(1) (+inf for a
+  // component no such direction depends on). A contact sliding along its own slip s / |s|
+  // (u / |u| under the coupled law) has a direction that varies on the scale of the slip
+  // itself, so the scale is |s| / |ds/dy_j|, the smallest over such contacts. A starting
+  // slip's solved direction (slip_start), a stuck contact and a direction held below
+  // coupled_floor do not depend on |s|.
+  void slip_scale(const StateVector& y, const ContactMode& mode, StateVector& scale) const;
+
   // Acceleration of the centre of the contact sphere of `slot` along z, from a state derivative.
   double gap_acceleration(const StateVector& y, const StateVector& dydt, int slot) const;
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <tuple>
+#include <utility>
 
 namespace tippe {
 namespace reference_detail {
@@ -39,8 +40,11 @@ class RosenbrockStepper final : public DenseStepper {
   using UMatrix = boost::numeric::ublas::matrix<double>;
   using Stepper = odeint::rosenbrock4_dense_output<odeint::rosenbrock4_controller<odeint::rosenbrock4<double>>>;
 
-  RosenbrockStepper(double atol, double rtol, double max_dt)
-      : stepper_(odeint::rosenbrock4_controller<odeint::rosenbrock4<double>>(atol, rtol, max_dt)), u_(kN), jac_(kN, kN) {}
+  RosenbrockStepper(double atol, double rtol, double max_dt, SmoothScale smooth)
+      : stepper_(odeint::rosenbrock4_controller<odeint::rosenbrock4<double>>(atol, rtol, max_dt)),
+        u_(kN),
+        jac_(kN, kN),
+        smooth_(std::move(smooth)) {}
 
   void initialize(const StateVector& y, double t, double dt) override {
     to_ublas(y, u_);
@@ -65,7 +69,7 @@ class RosenbrockStepper final : public DenseStepper {
       StateVector x0;
       from_ublas(x, x0);
       if (!have_jac || x0 != x_jac) {
-        fill_jacobian(sys, x0, t, jac_);
+        fill_jacobian(sys, smooth_, x0, t, jac_);
         x_jac = x0;
         have_jac = true;
       }
@@ -92,16 +96,33 @@ class RosenbrockStepper final : public DenseStepper {
   // embedded error estimate uses the same J, so an error in J escapes the step control (it
   // made the tilt error 50x larger at rtol 1e-10). scale_j is the larger of |y_j| and the norm
   // of its group (p, v, q, omega; 1 if that is 0), so a zero component is not perturbed at
-  // the scale of round-off.
-  static void fill_jacobian(const System& sys, const StateVector& x0, double t, UMatrix& J) {
+  // the scale of round-off; and at most the scale over which the right-hand side itself turns
+  // (`smooth`, ContactDynamics::slip_scale): a sliding Coulomb direction s / |s| turns on the
+  // scale of the slip, so the perturbation must be small against |s| as it is against |y_j|
+  // (the same cbrt(eps) balance, with |s| the scale), and it never carries the slip across
+  // zero. Without that bound, just past a slip start (|s| = 2.7e-7 m/s on leine_glocker at mu
+  // 0.02, tilt 1 rad) the perturbations of v, q and w moved the slip by 2 to 50 times |s|
+  // (w: 5.6e-6 m/s, q: 1.4e-5 m/s), so the differences spanned up to a half-turn of the
+  // direction: J's largest eigenvalue was 3.0e5 /s
+  // where the bounded differences give 1.5e6 /s (the direction's relaxation rate, ~mu F_n |W|
+  // / |s|), and the steps, whose error estimate is built on J, fell from 1.3e-4 s to 2e-9 s
+  // (a stall; likewise on leine_glocker_twin_coupled). With the bound: 3e-7 s there, growing
+  // with the slip. Bulirsch-Stoer and dopri5 do not use J and are unaffected.
+  static void fill_jacobian(const System& sys, const SmoothScale& smooth, const StateVector& x0, double t, UMatrix& J) {
     static constexpr size_t kGroups[5] = {0, 3, 6, 10, kN};
-    const double cbrt_eps = std::cbrt(std::numeric_limits<double>::epsilon());
+    const double eps = std::numeric_limits<double>::epsilon();
+    const double cbrt_eps = std::cbrt(eps);
+    StateVector bound;
+    bound.fill(std::numeric_limits<double>::infinity());
+    if (smooth) smooth(x0, bound);
     for (int grp = 0; grp < 4; ++grp) {
       double norm = 0.0;
       for (size_t i = kGroups[grp]; i < kGroups[grp + 1]; ++i) norm += x0[i] * x0[i];
       norm = std::sqrt(norm);
       for (size_t j = kGroups[grp]; j < kGroups[grp + 1]; ++j) {
-        const double scale = std::max({std::abs(x0[j]), norm, norm > 0 ? 0.0 : 1.0});
+        // The bound no finer than a few ulp of the component: the step must be representable.
+        const double own = std::max({std::abs(x0[j]), norm, norm > 0 ? 0.0 : 1.0});
+        const double scale = std::max(std::min(own, bound[j]), 4 * eps * std::abs(x0[j]) / cbrt_eps);
         StateVector xp = x0, xm = x0, fp, fm;
         xp[j] = x0[j] + cbrt_eps * scale;
         const double h = xp[j] - x0[j];  // the step as represented
@@ -121,14 +142,15 @@ class RosenbrockStepper final : public DenseStepper {
   Stepper stepper_;
   UVector u_;  // scratch for calc_state and initialize
   UMatrix jac_;
+  SmoothScale smooth_;
   StateVector y_{};
 };
 
 }  // namespace
 
-std::unique_ptr<DenseStepper> make_stepper(const RunSpec& run) {
+std::unique_ptr<DenseStepper> make_stepper(const RunSpec& run, SmoothScale scale) {
   const double max_dt = run.duration / 64.0;
-  if (run.method == "rosenbrock4") return std::make_unique<RosenbrockStepper>(run.atol, run.rtol, max_dt);
+  if (run.method == "rosenbrock4") return std::make_unique<RosenbrockStepper>(run.atol, run.rtol, max_dt, std::move(scale));
   if (run.method == "dopri5") {
     auto s = odeint::make_dense_output(run.atol, run.rtol, max_dt, Dopri());
     return std::make_unique<DenseStepperOf<decltype(s)>>(std::move(s));

@@ -24,9 +24,14 @@ struct DenseStepper {
   virtual double current_time_step() const = 0;
 };
 
+// Per state component, the change over which the right-hand side turns by O(1) where that is
+// shorter than the component's own size (+inf elsewhere): ContactDynamics::slip_scale for the
+// current mode. Only a stepper that differentiates the right-hand side (Rosenbrock4) uses it.
+using SmoothScale = std::function<void(const StateVector&, StateVector&)>;
+
 // The stepper of run.method ("bulirsch_stoer", "dopri5" or "rosenbrock4") at run.rtol and
-// run.atol, its largest step duration / 64.
-std::unique_ptr<DenseStepper> make_stepper(const RunSpec& run);
+// run.atol, its largest step duration / 64; `scale` bounds Rosenbrock4's Jacobian differences.
+std::unique_ptr<DenseStepper> make_stepper(const RunSpec& run, SmoothScale scale = nullptr);
 
 }  // namespace reference_detail
 }  // namespace tippe

@@ -125,7 +125,8 @@ struct ReferenceModel::Impl {
         dyn(BodyModel::from_scene(scene), scene.contact),
         run(scene.run),
         flight_allowed(scene.contact.flight),
-        stepper_ptr(reference_detail::make_stepper(scene.run)),
+        stepper_ptr(reference_detail::make_stepper(
+            scene.run, [this](const StateVector& y, StateVector& scale) { dyn.slip_scale(y, mode, scale); })),
         stepper(*stepper_ptr) {
     system = [this](const StateVector& y, StateVector& dy, double) {
       ++owner.rhs_evals_;

@@ -3,11 +3,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "reference_model.h"
 #include "scene.h"
 #include "simulator.h"
 #include "support/files.h"
@@ -107,6 +112,19 @@ inline void expect_refusal_naming(const std::function<void()>& call, const std::
     ADD_FAILURE() << what << " accepted " << want;
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+  }
+}
+
+// Expects two reference runs' events to be the same: names in the same order, times within
+// `tol` s (prints the largest difference).
+inline void expect_same_events(const std::vector<ReferenceEvent>& a, const std::vector<ReferenceEvent>& b, double tol) {
+  ASSERT_EQ(a.size(), b.size());
+  double largest = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) largest = std::max(largest, std::abs(a[i].time - b[i].time));
+  std::printf("%zu events, largest time difference between the methods %.3g s\n", a.size(), largest);
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].name, b[i].name) << i;
+    EXPECT_NEAR(a[i].time, b[i].time, tol) << a[i].name << " " << i;
   }
 }
 
