@@ -11,6 +11,7 @@
 #include "../analytic/reference_model.h"
 #include "io/scene_io.h"
 #include "support/fixtures.h"
+#include "support/reference_runs.h"
 #include "simulator.h"
 
 namespace tippe {
@@ -236,39 +237,7 @@ TEST(DrillingCoupled, StickThenSlipOnTheTwin) {
   EXPECT_LT(worst_drop, 1e-14);
 }
 
-// The twin run to 17.6 s (two slip starts) on `method`, sample by sample as the harness runs
-// it, with the checks the tests below share; its stick and slip events.
-std::vector<ReferenceEvent> twin_past_the_slip(const char* method) {
-  Scene s = shipped("leine_glocker_twin_coupled");
-  s.run.method = method;
-  s.run.duration = 17.6;
-  ReferenceModel m(s);
-  const BodyModel& b = m.body();
-  const double e0 = energy(b, m.state());
-  double w_prev = 0.0, worst_drop = 0.0, worst_ledger = 0.0;
-  for (int k = 1; k <= 17600 && m.status() == ReferenceStatus::Ok; ++k) {
-    m.advance_to(1e-3 * k);
-    const double w = m.energy_ledger().friction;
-    worst_drop = std::max(worst_drop, (w_prev - w) / e0);
-    w_prev = w;
-    worst_ledger = std::max(worst_ledger, std::abs(energy(b, m.state()) + m.energy_ledger().total() - e0) / e0);
-  }
-  EXPECT_EQ(m.status(), ReferenceStatus::Ok) << method << ": " << m.status_detail();
-  std::vector<ReferenceEvent> out;
-  int sticks = 0, slips = 0;
-  for (const auto& e : m.events()) {
-    if (e.name == "stick" || e.name == "slip") out.push_back(e);
-    sticks += e.name == "stick";
-    slips += e.name == "slip";
-  }
-  std::printf("twin to 17.6 s, %s: %d sticks, %d slips; ledger %.3g E0, friction work drop %.3g E0\n", method, sticks, slips,
-              worst_ledger, worst_drop);
-  EXPECT_EQ(sticks, 3) << method;
-  EXPECT_EQ(slips, 3) << method;
-  EXPECT_LT(worst_ledger, 1e-9) << method;
-  EXPECT_LT(worst_drop, 1e-12) << method;
-  return out;
-}
+using fixtures::twin_past_the_slip;
 
 // After that slip start the twin slides on, sticks and slips again: 16 stick/slip pairs by
 // 20 s. Before the reference solved a starting slip's direction (ContactSlot::slip_start),
@@ -284,22 +253,6 @@ TEST(DrillingCoupled, SlidesOnAfterTheSlipOnTheTwin) {
   const auto bs = twin_past_the_slip("bulirsch_stoer");
   const auto dp = twin_past_the_slip("dopri5");
   fixtures::expect_same_events(bs, dp, 1e-6);
-}
-
-// rosenbrock4 on the same run, with the same checks and the same agreement with
-// Bulirsch-Stoer as dopri5 above (1e-6 s, the margin of the ill-conditioned stick times;
-// measured 3.8e-8 s). It stalled 4 ms after the slip start ("no
-// progress" at 17.12461 s): where the solved start ended (ContactSlot::slip_start) the
-// generalised slip |(v, (mu_d / mu) w_z)| was 2.7e-7 m/s and its Jacobian's differences moved
-// it by 1 to 2.6 times that, spanning up to a half-turn of the friction direction; J's largest
-// eigenvalue was 1.1e7 /s against 3.0e7 /s with bounded differences (the direction's
-// relaxation rate), and the steps, their error estimate built on that J, fell from 6e-4 s to
-// 2e-9 s. The differences are now bounded by the slip's own scale (dense_stepper.cpp): steps
-// of ~2e-5 s there.
-TEST(DrillingCoupled, SlidesOnAfterTheSlipOnTheTwinByRosenbrock) {
-  const auto bs = twin_past_the_slip("bulirsch_stoer");
-  const auto ros = twin_past_the_slip("rosenbrock4");
-  fixtures::expect_same_events(bs, ros, 1e-6);
 }
 
 // Leine and Glocker: with the coupled law their top turns over and touches its stem within
