@@ -35,11 +35,22 @@ def main():
                          "where a rolling top stays)")
     a = ap.parse_args()
     if not os.path.isdir(os.path.join(a.checkout, "benchmarks", "tippetop")):
-        sys.exit(f"{a.checkout}: not a PyNonsmooth checkout (no benchmarks/tippetop)")
+        print(f"independent-leine-glocker: {a.checkout}: not a PyNonsmooth checkout (no benchmarks/tippetop)", file=sys.stderr)
+        sys.exit(2)
     sys.path[:0] = [a.checkout, os.path.join(a.checkout, "benchmarks", "tippetop")]
-    import numpy as np
-    from tippetop_system import Tippetop_Leine2003, Tippetop_quaternion
-    from solvers.moreau import Moreau
+    try:
+        import numpy as np
+        import tqdm  # noqa: F401 (the solver's progress bar)
+    except ImportError as e:
+        print(f"independent-leine-glocker: {e.name} is missing: install Debian's python3-numpy and python3-tqdm",
+              file=sys.stderr)
+        sys.exit(2)
+    try:
+        from tippetop_system import Tippetop_Leine2003, Tippetop_quaternion
+        from solvers.moreau import Moreau
+    except ImportError as e:
+        print(f"independent-leine-glocker: {a.checkout}: {e} (not the expected PyNonsmooth checkout?)", file=sys.stderr)
+        sys.exit(2)
 
     # The model takes the patch radius R and bounds the drilling torque by mu * (3 pi / 16) R.
     radius = {"hertzian": 0.5e-3, "uniform": (2.0 / 3.0 * 0.5e-3) / (3.0 * math.pi / 16.0), "point": 1e-9}[a.patch]
