@@ -1,10 +1,10 @@
 // Bullet adapter, checks and notes: the rotation clamp and the dropped gyroscopic term watched each internal step, and the notes that state the run's modelling choices.
+#include "bullet_adapter.h"
+
 #include <cmath>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include "bullet_adapter.h"
 
 namespace tippe {
 

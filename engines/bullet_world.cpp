@@ -1,7 +1,8 @@
 // Bullet adapter, construction: the world with its per-point material hook, the floor, the top's compound body at G and the solver's settings, from the scene.
+#include "bullet_adapter.h"
+
 #include <stdexcept>
 
-#include "bullet_adapter.h"
 #include "settings.h"
 
 namespace tippe {

@@ -1,10 +1,10 @@
 // Derives the reference's top from a user's checked MuJoCo model: mass properties and symmetry axis, stem geometry, the contact law read from probe contacts, and the exact start.
+#include "mujoco_import_analyser.h"
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
-
-#include "mujoco_import_analyser.h"
 
 namespace tippe::mjcf_import_detail {
 namespace {
