@@ -28,6 +28,7 @@
 #include "io/provenance.h"
 #include "io/scene_io.h"
 #include "measure/task_farm.h"
+#include "measure/run.h"
 
 namespace tippe {
 
