@@ -13,17 +13,22 @@
 
 namespace tippe {
 
-RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, ProgressFn progress) {
+RunRecord record_of_scene(const Scene& scene) {
   RunRecord r;
   r.provenance = current_provenance();
   r.scene_name = scene.name;
   r.scene_file = scene.source_file;
   r.scene_hash = scene.content_hash;
   r.scene_spec = scene_to_json(scene);
-  r.engine = sim.engine();
-  r.engine_version = sim.version();
   r.mass = scene.mass;
   r.inversion_possible = inversion_possible(scene.mass, scene.body.sphere_radius);
+  return r;
+}
+
+RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, ProgressFn progress) {
+  RunRecord r = record_of_scene(scene);
+  r.engine = sim.engine();
+  r.engine_version = sim.version();
 
   const double dt = scene.run.sample_interval, T = scene.run.duration;
   // The tolerance keeps e.g. 8 / 0.001 = 7999.999... from losing its last grid point.
