@@ -9,6 +9,7 @@
 #include "io/progress.h"
 #include "registry.h"
 #include "records/records.h"
+#include "measure/run.h"
 #include "io/scene_io.h"
 
 namespace tippe::cli {

@@ -1,4 +1,4 @@
-// Scene files: TOML -> Scene with every key checked, command-line overrides, and Scene -> JSON.
+// Reading scene files: TOML -> Scene with every key checked, and command-line overrides.
 #include "io/scene_io.h"
 #include "io/hash.h"
 #include "io/text.h"
@@ -62,40 +62,6 @@ bool is_bare_key(const std::string& s) {
   });
 }
 
-// Length of the well-formed UTF-8 sequence at s[i] (RFC 3629: no overlong forms, no surrogates,
-// nothing above U+10FFFF), 0 when there is none. What toml++ enforces on a document, checked here
-// on the text that does not pass through it.
-size_t utf8_sequence(const std::string& s, size_t i) {
-  const size_t n = s.size();
-  const auto c = static_cast<unsigned char>(s[i]);
-  size_t len;
-  unsigned lo = 0x80, hi = 0xBF;  // range of the second byte
-  if (c < 0x80) len = 1;
-  else if (c >= 0xC2 && c <= 0xDF) len = 2;
-  else if (c >= 0xE0 && c <= 0xEF) {
-    len = 3;
-    if (c == 0xE0) lo = 0xA0;
-    if (c == 0xED) hi = 0x9F;
-  } else if (c >= 0xF0 && c <= 0xF4) {
-    len = 4;
-    if (c == 0xF0) lo = 0x90;
-    if (c == 0xF4) hi = 0x8F;
-  } else return 0;
-  if (n - i < len) return 0;
-  for (size_t k = 1; k < len; ++k) {
-    const auto b = static_cast<unsigned char>(s[i + k]);
-    if (k == 1 ? (b < lo || b > hi) : (b < 0x80 || b > 0xBF)) return 0;
-  }
-  return len;
-}
-
-bool is_utf8(const std::string& s) {
-  for (size_t i = 0, len; i < s.size(); i += len)
-    if ((len = utf8_sequence(s, i)) == 0) return false;
-  return true;
-}
-
-
 // Interprets a parsed scene document; every error names the file and the dotted key.
 class Interpreter : public TomlReader {
  public:
@@ -124,7 +90,7 @@ class Interpreter : public TomlReader {
     if (!is_toml) {
       // A bare word becomes a TOML string, which must be UTF-8; the run's records are JSON,
       // whose writer would otherwise throw only after the whole run.
-      if (!is_utf8(value_text)) fail("--set", "the value of " + key + " is not valid UTF-8");
+      if (!is_valid_utf8(value_text)) fail("--set", "the value of " + key + " is not valid UTF-8");
       parsed = toml::table{};
       parsed.insert("v", value_text);
     }
@@ -462,33 +428,6 @@ class Interpreter : public TomlReader {
 
 }  // namespace
 
-const char* const kNameRule = "letters, digits, '.', '_', '-'";
-
-bool is_valid_name(const std::string& n) {
-  return !n.empty() && n != "." && n != ".." && std::all_of(n.begin(), n.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
-           c == '.';
-  });
-}
-
-bool is_valid_utf8(const std::string& s) { return is_utf8(s); }
-
-std::string utf8_replaced(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (size_t i = 0; i < s.size();) {
-    const size_t len = utf8_sequence(s, i);
-    if (len == 0) {
-      out += "\xEF\xBF\xBD";  // U+FFFD
-      ++i;
-    } else {
-      out.append(s, i, len);
-      i += len;
-    }
-  }
-  return out;
-}
-
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
   std::string text;
   try {
@@ -502,7 +441,7 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
 Scene parse_scene_text(const std::string& text, const std::string& file_label,
                        const std::vector<std::string>& overrides) {
   // The label is the scene's source_file in every JSON record: checked before any work is done.
-  if (!is_utf8(file_label)) throw SceneError(file_label + ": cannot read: the path is not valid UTF-8");
+  if (!is_valid_utf8(file_label)) throw SceneError(file_label + ": cannot read: the path is not valid UTF-8");
   toml::table root = parse_toml(text, file_label);
 
   std::set<std::string> overridden;
@@ -518,69 +457,6 @@ Scene parse_scene_text(const std::string& text, const std::string& file_label,
                                                      overrides)
                                       : fnv1a64_hex(text, overrides);
   return s;
-}
-
-nlohmann::json setting_to_json(const SettingValue& value) {
-  return std::visit([](const auto& v) { return nlohmann::json(v); }, value);
-}
-
-nlohmann::json scene_to_json(const Scene& s) {
-  using nlohmann::json;
-  json engines = json::object();
-  for (const auto& [engine, table] : s.engines) {
-    json t = json::object();
-    for (const auto& [k, v] : table) t[k] = setting_to_json(v);
-    engines[engine] = t;
-  }
-  json out{
-      {"name", s.name},
-      {"description", s.description},
-      {"source_file", s.source_file},
-      {"content_hash", s.content_hash},
-      {"gravity", s.gravity},
-      {"body",
-       {{"sphere_radius", s.body.sphere_radius},
-        {"stem_radius", s.body.stem_radius},
-        {"stem_length", s.body.stem_length},
-        {"truncation_height", s.body.truncation_height},
-        {"density", s.body.density},
-        {"mass_model", to_string(s.body.mass_model)}}},
-      {"mass_properties",
-       {{"mass", s.mass.mass},
-        {"com_offset", s.mass.com_offset},
-        {"inertia_transverse", s.mass.inertia_transverse},
-        {"inertia_axial", s.mass.inertia_axial}}},
-      {"contact",
-       {{"friction", to_string(s.contact.friction)},
-        {"mu", s.contact.mu},
-        {"k", s.contact.k},
-        {"drilling", s.contact.drilling},
-        {"drilling_law", to_string(s.contact.drilling_law)},
-        {"stem", s.contact.stem},
-        {"flight", s.contact.flight}}},
-      {"initial",
-       {{"tilt", s.initial.tilt},
-        {"omega_given", s.initial.omega_given},
-        {"spin", s.initial.spin},
-        {"omega", s.initial.omega_B},
-        {"velocity_given", s.initial.velocity_given},
-        {"velocity", s.initial.velocity},
-        {"omega_along_contact", s.initial.omega_along_contact},
-        {"height", s.initial.height}}},
-      {"run",
-       {{"duration", s.run.duration},
-        {"sample_interval", s.run.sample_interval},
-        {"rtol", s.run.rtol},
-        {"atol", s.run.atol},
-        {"method", s.run.method},
-        {"self_check", s.run.self_check}}},
-      {"engines", engines},
-  };
-  // Written only when used, so that the JSON (and the physics hash) of every other scene stays as it was.
-  if (s.initial.orientation_given) out["initial"]["orientation"] = s.initial.orientation;
-  if (s.initial.position[0] != 0.0 || s.initial.position[1] != 0.0) out["initial"]["position"] = s.initial.position;
-  if (!s.notes.empty()) out["notes"] = s.notes;
-  return out;
 }
 
 }  // namespace tippe

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "records/records.h"
+#include "measure/run.h"
 #include "io/scene_io.h"
 
 namespace tippe {

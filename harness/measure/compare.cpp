@@ -24,10 +24,10 @@
 #include "io/interrupt.h"
 #include "io/text.h"
 #include "io/progress.h"
-#include "mass_properties.h"
 #include "io/provenance.h"
 #include "io/scene_io.h"
 #include "measure/task_farm.h"
+#include "measure/run.h"
 
 namespace tippe {
 
@@ -63,19 +63,12 @@ class GuardedSink : public SampleSink {
 // What a run leaves when its simulator could not be built or threw: a record that says so.
 RunRecord failed_record(const Scene& scene, const std::string& engine, const std::string& why,
                         const Trajectory& tr) {
-  RunRecord r;
-  r.provenance = current_provenance();
-  r.scene_name = scene.name;
-  r.scene_file = scene.source_file;
-  r.scene_hash = scene.content_hash;
-  r.scene_spec = scene_to_json(scene);
+  RunRecord r = record_of_scene(scene);
   r.engine = engine;
   r.engine_version = "unknown";
   r.status = to_string(RunStatus::Failed);
   r.status_time = tr.size() ? tr.t.back() : 0.0;
   r.status_detail = why;
-  r.mass = scene.mass;
-  r.inversion_possible = inversion_possible(scene.mass, scene.body.sphere_radius);
   r.samples = static_cast<long long>(tr.size());
   r.final_time = tr.size() ? tr.t.back() : kNaN;
   r.final_tilt = tr.size() ? tr.theta.back() : kNaN;

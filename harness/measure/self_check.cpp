@@ -8,6 +8,7 @@
 #include <limits>
 #include "io/json_fields.h"
 #include "records/records.h"
+#include "measure/run.h"
 #include "registry.h"
 
 namespace tippe {

@@ -1,4 +1,4 @@
-// Run records: running a scene on one simulator, its summary numbers, JSON and CSV writers, atomic files.
+// Run records: their summary numbers, JSON and CSV writers, atomic files.
 #include "records/records.h"
 #include "io/json_fields.h"
 
@@ -20,10 +20,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "mass_properties.h"
-#include "io/interrupt.h"
 #include "io/provenance.h"
-#include "io/scene_io.h"
 
 namespace tippe {
 
@@ -102,67 +99,6 @@ void SampleSummary::fill(RunRecord& r) const {
     r.jellett_max_relative_drift = std::max(drift_ball_.value_or(0.0), drift_stem_.value_or(0.0));
   else
     r.jellett_max_relative_drift = kNaN;
-}
-
-RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, ProgressFn progress) {
-  RunRecord r;
-  r.provenance = current_provenance();
-  r.scene_name = scene.name;
-  r.scene_file = scene.source_file;
-  r.scene_hash = scene.content_hash;
-  r.scene_spec = scene_to_json(scene);
-  r.engine = sim.engine();
-  r.engine_version = sim.version();
-  r.mass = scene.mass;
-  r.inversion_possible = inversion_possible(scene.mass, scene.body.sphere_radius);
-
-  const double dt = scene.run.sample_interval, T = scene.run.duration;
-  // The tolerance keeps e.g. 8 / 0.001 = 7999.999... from losing its last grid point.
-  const long long n = static_cast<long long>(std::floor(T / dt + 1e-9));
-  SampleSummary summary;
-  double last_t = -std::numeric_limits<double>::infinity();
-  size_t events_seen = 0;
-  auto emit = [&](const Observation& o) {
-    // The interface has no "events since": copying the list per sample is cheap next to a step.
-    const std::vector<Event> events = sim.events();
-    bool switched = false;
-    for (size_t i = events_seen; i < events.size(); ++i) switched = switched || events[i].name == "switch";
-    events_seen = events.size();
-    summary.add(o, switched);
-    if (sink) sink->write(o);
-    last_t = o.state.t;
-    if (progress) progress(o.state.t, T);
-    // Between samples a deferred SIGINT or SIGTERM ends the run (see interrupt.h).
-    check_interrupted();
-  };
-  emit(sim.observe());
-  for (long long k = 1; k <= n && sim.status() == RunStatus::Ok; ++k) {
-    double t = static_cast<double>(k) * dt;
-    if (k == n && std::abs(t - T) <= 1e-9 * dt) t = T;
-    sim.advance_to(t);
-    const Observation o = sim.observe();
-    // A simulator that stopped may report the state it stopped at, which can repeat the last sample.
-    if (sim.status() == RunStatus::Ok || o.state.t > last_t) emit(o);
-  }
-  summary.fill(r);
-
-  r.status = to_string(sim.status());
-  r.status_time = sim.status_time();
-  r.status_detail = sim.status_detail();
-  r.events = sim.events();
-  r.settings = sim.settings();
-  r.notes = sim.notes();
-  r.work = sim.work();
-  for (const Event& e : r.events) {
-    if (e.name == "inversion" && !r.inversion_time) r.inversion_time = e.time;
-    if (e.name == "stem_contact" && !r.stem_contact_time) r.stem_contact_time = e.time;
-  }
-  return r;
-}
-
-RunRecord run_scene(const Scene& scene, const std::string& engine, SampleSink* sink, ProgressFn progress) {
-  auto sim = make_simulator(engine, scene);
-  return run_simulator(*sim, scene, sink, std::move(progress));
 }
 
 json to_json(const RunRecord& r) {

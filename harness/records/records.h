@@ -1,9 +1,8 @@
-// Run records: running a scene on one simulator, its summary numbers, JSON and CSV writers, atomic files.
+// Run records: their summary numbers, JSON and CSV writers, atomic files.
 #pragma once
 
 #include <cstddef>
 #include <cstdio>
-#include <functional>
 #include <istream>
 #include <map>
 #include <optional>
@@ -86,18 +85,6 @@ class SampleSummary {
   double run_j0_ = 0.0;
   std::optional<double> drift_ball_, drift_stem_;
 };
-
-// Called after every sample with the sample's time and the run's duration.
-using ProgressFn = std::function<void(double t, double duration)>;
-
-// Samples the simulator on the grid t_k = k * sample_interval, k = 0..floor(duration /
-// sample_interval) (the last point snapped to duration when within rounding), streams each
-// observation to `sink` (may be null), and stops after the first sample taken once the status
-// leaves ok (that sample carries its own, earlier, time). Fills every field of the record.
-RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, ProgressFn progress = {});
-// make_simulator(engine, scene) followed by run_simulator; std::invalid_argument from
-// make_simulator (unknown engine, bad setting) passes through.
-RunRecord run_scene(const Scene& scene, const std::string& engine, SampleSink* sink, ProgressFn progress = {});
 
 // The "format" of summary.json (schemas/run-summary.schema.json).
 constexpr const char* kRunRecordFormat = "tippe-run-1";

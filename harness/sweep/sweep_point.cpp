@@ -12,6 +12,7 @@
 #include "io/provenance.h"
 #include "measure/classify.h"
 #include "records/records.h"
+#include "measure/run.h"
 
 namespace tippe::sweep_detail {
 

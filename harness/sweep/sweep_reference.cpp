@@ -10,6 +10,7 @@
 #include "io/json_fields.h"
 #include "io/text.h"
 #include "records/records.h"
+#include "measure/run.h"
 
 namespace tippe::sweep_detail {
 

@@ -13,6 +13,7 @@
 #include "../analytic/contact_dynamics.h"
 #include "../analytic/initial_state.h"
 #include "records/records.h"
+#include "measure/run.h"
 #include "registry.h"
 
 namespace tippe {

@@ -23,6 +23,7 @@
 #include "mujoco_import.h"
 #include "mujoco_sim.h"
 #include "records/records.h"
+#include "measure/run.h"
 #include "io/scene_io.h"
 #include "simulator.h"
 #include "support/process.h"

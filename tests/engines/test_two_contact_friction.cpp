@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "records/records.h"
+#include "measure/run.h"
 #include "registry.h"
 #include "io/scene_io.h"
 

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "records/records.h"
+#include "measure/run.h"
 #include "io/scene_io.h"
 #include "support/files.h"
 #include "support/fixtures.h"

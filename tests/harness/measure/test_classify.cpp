@@ -8,6 +8,7 @@
 #include "measure/classify.h"
 #include "measure/compare.h"
 #include "records/records.h"
+#include "measure/run.h"
 #include "io/scene_io.h"
 
 namespace tippe {
