@@ -19,11 +19,7 @@ namespace {
 
 Scene shipped(const std::string& name) { return load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/" + name + ".toml"); }
 
-std::optional<double> first_event(const std::vector<ReferenceEvent>& events, const std::string& name) {
-  for (const auto& e : events)
-    if (e.name == name) return e.time;
-  return std::nullopt;
-}
+using fixtures::first_event;
 
 // A centred solid ball (d = 0, I = 2/5 M R^2) under the coupled law, upright, with a spin w0
 // about the vertical and G sliding at v0 along x. Centred, its normal force stays M g and its

@@ -10,17 +10,12 @@
 #include "io/scene_io.h"
 #include "observables.h"
 #include "support/fixtures.h"
+#include "support/reference_runs.h"
 
 namespace tippe {
 namespace {
 
-Scene shipped_scene(const std::string& name) { return load_scene(fixtures::kScenesDir + name + ".toml"); }
-
-std::optional<double> first_event(const std::vector<ReferenceEvent>& events, const std::string& name) {
-  for (const auto& e : events)
-    if (e.name == name) return e.time;
-  return std::nullopt;
-}
+using fixtures::first_event;
 
 double stem_touchdown(Scene s) {
   s.run.duration = 1.45;  // the touchdown is at ~1.37 s
@@ -46,7 +41,7 @@ double stem_touchdown(Scene s) {
 // first order and not monotone); the published reading (~1.5 s) is 130 ms away, and mu_d off by
 // 25 % moves the touchdown by 5 ms (0.75e-4 m: 1.36837 s).
 TEST(LeineGlockerPublished, StemTouchdownAgreesWithAnIndependentImplementation) {
-  Scene uniform = shipped_scene("leine_glocker_coupled");
+  Scene uniform = fixtures::shipped_reference_scene("leine_glocker_coupled");
   ASSERT_DOUBLE_EQ(uniform.contact.drilling, 1e-4);  // the values above are for this scene
   Scene hertzian = uniform;
   hertzian.contact.drilling = 0.3 * 3.0 * M_PI / 16.0 * 0.5e-3;
@@ -65,7 +60,7 @@ TEST(LeineGlockerPublished, StemTouchdownAgreesWithAnIndependentImplementation) 
 // is 0.127 s earlier, which is why reading the figure's time as the touchdown looked like a
 // disagreement (withdrawn, BENCHMARKS.md).
 TEST(LeineGlockerPublished, StandsOnItsStemAtThePublishedTime) {
-  const Scene s = shipped_scene("leine_glocker_coupled");
+  const Scene s = fixtures::shipped_reference_scene("leine_glocker_coupled");
   ReferenceModel m(s);
   const double dt = 1e-3;  // the scene's sample interval: the time of the largest tilt to 1 ms
   double t_max = -1.0, th_max = 0.0;

@@ -15,17 +15,14 @@
 #include "registry.h"
 #include "io/scene_io.h"
 #include "simulator.h"
+#include "support/reference_runs.h"
 
 namespace tippe {
 namespace {
 
 Scene gliding_ball() { return load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/rutstam_gliding_ball.toml"); }
 
-std::optional<double> first_event(const std::vector<ReferenceEvent>& events, const std::string& name) {
-  for (const auto& e : events)
-    if (e.name == name) return e.time;
-  return std::nullopt;
-}
+using fixtures::first_event;
 
 double reference_inversion(const Scene& scene) {
   ReferenceModel m(scene);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,13 @@
 #include "reference_model.h"
 
 namespace tippe::fixtures {
+
+// The time of the first event of that name, if any.
+inline std::optional<double> first_event(const std::vector<ReferenceEvent>& events, const std::string& name) {
+  for (const auto& e : events)
+    if (e.name == name) return e.time;
+  return std::nullopt;
+}
 
 inline Scene shipped_reference_scene(const std::string& name) {
   return load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/" + name + ".toml");
