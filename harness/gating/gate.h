@@ -18,7 +18,7 @@ struct Check {
   std::string name;
   std::string scene;       // as written in the gate file
   std::string scene_path;  // resolved against the gate file's directory
-  std::string engine;      // a registered engine (engines/registry.h), not the reference
+  std::string engine;      // a registered engine (engines/core/registry.h), not the reference
   std::vector<std::string> set;        // [defaults].set then the check's own, as written
   std::optional<double> duration;      // the check's duration, else [defaults].duration
   std::vector<std::string> overrides;  // what load_scene gets: run.duration=... first, then `set`

@@ -15,7 +15,7 @@
 namespace tippe {
 
 struct CompareOptions {
-  std::vector<std::string> engines = engine_names();  // every registered engine (engines/registry.h)
+  std::vector<std::string> engines = engine_names();  // every registered engine (engines/core/registry.h)
   int jobs = 1;
   std::string out_dir;    // where comparison.json, trajectories and reports go ("" = none)
   std::string cache_dir;  // reference cache ("" = no cache)

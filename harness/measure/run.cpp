@@ -10,6 +10,7 @@
 #include "mass_properties.h"
 #include "io/interrupt.h"
 #include "io/scene_io.h"
+#include "timing.h"
 
 namespace tippe {
 
@@ -37,11 +38,13 @@ RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, Pr
   double last_t = -std::numeric_limits<double>::infinity();
   size_t events_seen = 0;
   auto emit = [&](const Observation& o) {
-    // The interface has no "events since": copying the list per sample is cheap next to a step.
-    const std::vector<Event> events = sim.events();
+    // The list is copied only when it grew: most samples see no new event.
     bool switched = false;
-    for (size_t i = events_seen; i < events.size(); ++i) switched = switched || events[i].name == "switch";
-    events_seen = events.size();
+    if (sim.event_count() != events_seen) {
+      const std::vector<Event> events = sim.events();
+      for (size_t i = events_seen; i < events.size(); ++i) switched = switched || events[i].name == "switch";
+      events_seen = events.size();
+    }
     summary.add(o, switched);
     if (sink) sink->write(o);
     last_t = o.state.t;
@@ -49,6 +52,8 @@ RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, Pr
     // Between samples a deferred SIGINT or SIGTERM ends the run (see interrupt.h).
     check_interrupted();
   };
+  // The run's clocks: read here and after the loop only (see WorkCounters).
+  const SpanTimer timer;
   emit(sim.observe());
   for (long long k = 1; k <= n && sim.status() == RunStatus::Ok; ++k) {
     double t = static_cast<double>(k) * dt;
@@ -58,6 +63,8 @@ RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, Pr
     // A simulator that stopped may report the state it stopped at, which can repeat the last sample.
     if (sim.status() == RunStatus::Ok || o.state.t > last_t) emit(o);
   }
+  double wall = 0, cpu = 0;
+  timer.stop(wall, cpu);
   summary.fill(r);
 
   r.status = to_string(sim.status());
@@ -67,6 +74,8 @@ RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, Pr
   r.settings = sim.settings();
   r.notes = sim.notes();
   r.work = sim.work();
+  r.work.wall_seconds = wall;
+  r.work.cpu_seconds = cpu;
   for (const Event& e : r.events) {
     if (e.name == "inversion" && !r.inversion_time) r.inversion_time = e.time;
     if (e.name == "stem_contact" && !r.stem_contact_time) r.stem_contact_time = e.time;

@@ -1,7 +1,7 @@
 // Google Benchmark: step cost of each engine on the toy scene, and the adapter's overhead.
 #include <benchmark/benchmark.h>
 
-#include "../../engines/fixed_step.h"
+#include "fixed_step.h"
 #include "registry.h"
 #include "io/scene_io.h"
 
@@ -56,7 +56,7 @@ void BM_LibrarySteps(benchmark::State& state, const std::string& engine) {
 
 }  // namespace tippe
 
-// The three benchmarks for every registered engine (engines/registry.h): a new engine is measured
+// The three benchmarks for every registered engine (engines/core/registry.h): a new engine is measured
 // without an edit here.
 int main(int argc, char** argv) {
   for (const std::string& e : tippe::engine_names()) {

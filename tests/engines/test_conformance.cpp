@@ -342,6 +342,28 @@ TEST_P(Conformance, Deterministic) {
   EXPECT_TRUE(a == b) << "two runs of the same scene differ";
 }
 
+TEST_P(Conformance, NameAndVersionAreTheRegistrys) {
+  auto sim = make(base_scene());
+  EXPECT_EQ(sim->engine(), row().engine);
+  EXPECT_EQ(sim->version(), engine_info(row().engine).version);
+}
+
+TEST_P(Conformance, TheRunReadsItsClocksNotTheSimulator) {
+  // The run's wall and CPU time come from run_simulator, read at its loop's two ends; a
+  // simulator leaves them 0 (a thread CPU clock read around each advance_to, a system call,
+  // cost more than a sample).
+  Scene s = base_scene();
+  s.run.duration = 0.5;
+  auto sim = make(s);
+  const RunRecord r = run_simulator(*sim, s, nullptr);
+  EXPECT_EQ(sim->work().wall_seconds, 0.0);
+  EXPECT_EQ(sim->work().cpu_seconds, 0.0);
+  EXPECT_GT(r.work.wall_seconds, 0.0);
+  EXPECT_GT(r.work.cpu_seconds, 0.0);
+  EXPECT_EQ(r.work.steps, sim->work().steps);
+  EXPECT_EQ(sim->event_count(), sim->events().size());
+}
+
 INSTANTIATE_TEST_SUITE_P(Engines, Conformance, ::testing::ValuesIn(kEngines),
                          [](const ::testing::TestParamInfo<EngineRow>& info) { return std::string(info.param.engine); });
 
@@ -351,6 +373,28 @@ TEST(ConformanceTable, CoversTheRegistry) {
   for (const EngineRow& r : kEngines) rows.insert(r.engine);
   for (const std::string& e : available_engines()) EXPECT_TRUE(rows.count(e)) << e << " has no row in kEngines";
   EXPECT_EQ(rows.size(), available_engines().size());
+}
+
+// A key engines share has one bound for all of them (shared_settings in engines/core/settings.h):
+// every engine with a `timestep` takes 0.1 and refuses the next value up.
+TEST(ConformanceTable, SharedKeysHaveOneBound) {
+  int engines_with_timestep = 0;
+  for (const std::string& name : engine_names()) {
+    const SettingsList defaults = engine_info(name).default_settings();
+    if (std::none_of(defaults.begin(), defaults.end(), [](const auto& kv) { return kv.first == "timestep"; })) continue;
+    ++engines_with_timestep;
+    Scene s = base_scene();
+    s.engines[name]["timestep"] = 0.1;
+    EXPECT_NO_THROW(engine_info(name).validate(s)) << name;
+    s.engines[name]["timestep"] = 0.11;
+    try {
+      engine_info(name).validate(s);
+      ADD_FAILURE() << name << " accepted timestep = 0.11";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("outside [1e-08, 0.1]"), std::string::npos) << name << ": " << e.what();
+    }
+  }
+  EXPECT_GE(engines_with_timestep, 1);
 }
 
 // ---- The reference's right-hand side at t = 0, against hand-derived values -------------------------

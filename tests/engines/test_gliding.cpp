@@ -256,7 +256,7 @@ TEST_P(GlidingEngineSlide, MatchesTheClosedForm) {
   std::printf("sliding ball, %s: v_G against the closed form, worst %.3g of v0\n", GetParam().c_str(), worst);
   EXPECT_LT(worst, 1e-3);
 }
-// Every registered engine (engines/registry.h).
+// Every registered engine (engines/core/registry.h).
 INSTANTIATE_TEST_SUITE_P(Engines, GlidingEngineSlide, ::testing::ValuesIn(engine_names()),
                          [](const auto& info) { return info.param; });
 

@@ -87,7 +87,7 @@ Scene with_keyframe_velocity(Scene s) {
 
 // Plain MuJoCo from the keyframe: the first time e_Z (body +z, from the ball towards the stem)
 // crosses the horizontal, by linear interpolation of its vertical component between the two step
-// ends, as the bench's track_events (engines/fixed_step.cpp) does; -1 if not within kHorizon.
+// ends, as the bench's track_events (engines/core/fixed_step.cpp) does; -1 if not within kHorizon.
 double plain_inversion_time() {
   const ModelPtr m = load_tutorial();
   if (!m) return -1;

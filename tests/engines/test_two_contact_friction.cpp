@@ -104,7 +104,7 @@ TEST_P(TwoContactsTouch, BothContactsAreMadeWhenBothTouch) {
   EXPECT_TRUE(both) << engine << " never reports ball and stem contacts together";
 }
 
-// Every registered engine (engines/registry.h).
+// Every registered engine (engines/core/registry.h).
 INSTANTIATE_TEST_SUITE_P(Engines, TwoContactFriction, ::testing::ValuesIn(engine_names()),
                          [](const auto& info) { return info.param; });
 

@@ -1,16 +1,9 @@
-// The registry of simulators: the one list a new engine is added to (one line each).
+// The registry of simulators: the reference and the engines of engine_list.h (one line each).
 #include "registry.h"
 
 #include <stdexcept>
 
 namespace tippe {
-
-// Each adapter file defines its EngineInfo.
-const EngineInfo& analytic_engine_info();
-const EngineInfo& bullet_engine_info();
-const EngineInfo& ode_engine_info();
-const EngineInfo& mujoco_engine_info();
-const EngineInfo& dart_engine_info();
 
 const std::vector<EngineInfo>& engine_registry() {
 #ifdef TIPPE_REFERENCE_ONLY
@@ -18,7 +11,10 @@ const std::vector<EngineInfo>& engine_registry() {
   static const std::vector<EngineInfo> registry = {analytic_engine_info()};
 #else
   static const std::vector<EngineInfo> registry = {
-      analytic_engine_info(), bullet_engine_info(), ode_engine_info(), mujoco_engine_info(), dart_engine_info(),
+      analytic_engine_info(),
+#define TIPPE_ENGINE(name) name##_engine_info(),
+#include "engine_list.h"
+#undef TIPPE_ENGINE
   };
 #endif
   return registry;

@@ -87,21 +87,21 @@ struct OdeSettings {
 
   template <class V>
   void visit(V& v) {
-    v("timestep", timestep, 1e-8, 0.1);
+    shared_settings::timestep(v, timestep);
     v("stepper", stepper, {"step", "quickstep"});
-    v("iterations", iterations, 1, 1000000);
-    v("erp", erp, 0.0, 1.0);
-    v("cfm", cfm, 0.0, 1.0);
-    v("soft_erp", soft_erp, 0.0, 1.0);
-    v("soft_cfm", soft_cfm, 0.0, 1.0);
+    shared_settings::iterations(v, "iterations", iterations);
+    shared_settings::fraction(v, "erp", erp);
+    shared_settings::fraction(v, "cfm", cfm);
+    shared_settings::fraction(v, "soft_erp", soft_erp);
+    shared_settings::fraction(v, "soft_cfm", soft_cfm);
     v("surface_layer", surface_layer, 0.0, 1.0);
     v("finite_rotation", finite_rotation);
     v("gyroscopic", gyroscopic);
     v("seed", seed, 0, INT_MAX);
     v("max_contacts", max_contacts, 1, 64);
-    v("stem_shape", stem_shape, {"capsule", "tip_sphere"});
+    shared_settings::stem_shape(v, stem_shape);
     v("friction_model", friction_model, {"approx1", "box"});
-    v("rolling_mu", rolling_mu, 0.0, 1e15);
+    shared_settings::rolling_mu(v, rolling_mu);
   }
 };
 
@@ -205,10 +205,7 @@ class OdeSimulator : public FixedStepSimulator {
   OdeSimulator(const OdeSimulator&) = delete;
   OdeSimulator& operator=(const OdeSimulator&) = delete;
 
-  std::string engine() const override { return "ode"; }
-  std::string version() const override { return std::string("ode ") + dODE_VERSION; }
   SettingsList settings() const override { return list_settings(settings_); }
-  std::vector<std::string> notes() const override { return notes_; }
 
   OdeMassReadback mass_readback() const;
   MassReadback mass_properties() const override {
@@ -221,10 +218,7 @@ class OdeSimulator : public FixedStepSimulator {
   void engine_step() override;
   BodyState engine_state() const override;
   void engine_set_state(const BodyState& x) override;
-  ContactReport engine_contacts() const override { return report_; }
   void apply_force_W(const Vec3& f_W, const Vec3& p_W) override;
-  std::string engine_limit_hit() const override { return limit_; }
-  long long engine_solver_iterations() const override { return solver_iterations_; }
 
  private:
   struct ContactRecord {
@@ -238,7 +232,6 @@ class OdeSimulator : public FixedStepSimulator {
   void make_notes();
 
   OdeSettings settings_;
-  std::vector<std::string> notes_;
   OdeWorld ode_;
   // Aliases of ode_'s handles, for brevity.
   dWorldID world_ = nullptr;
@@ -251,14 +244,11 @@ class OdeSimulator : public FixedStepSimulator {
   std::vector<ContactRecord> contacts_;
   size_t n_contacts_ = 0;
   std::vector<dContactGeom> scratch_;
-  ContactReport report_;
-  std::string limit_;
   bool failed_ = false;  // ODE raised an internal error: the state is reported as NaN
-  long long solver_iterations_ = 0;
 };
 
 OdeSimulator::OdeSimulator(const Scene& scene)
-    : FixedStepSimulator(scene), settings_(read_settings<OdeSettings>("ode", scene)) {
+    : FixedStepSimulator(scene, ode_engine_info()), settings_(read_settings<OdeSettings>("ode", scene)) {
   check_combination(settings_, scene);
   ode_thread_init();
   // dReal is double by this build's headers; the library must agree or every call is garbage.
@@ -523,16 +513,9 @@ std::unique_ptr<Simulator> make_ode_simulator(const Scene& scene) {
 void validate_ode_settings(const Scene& scene) { check_combination(read_settings<OdeSettings>("ode", scene), scene); }
 
 const EngineInfo& ode_engine_info() {
-  static const EngineInfo info = [] {
-    EngineInfo e;
-    e.name = "ode";
-    e.role = EngineRole::Engine;
-    e.make = make_ode_simulator;
-    set_settings_struct<OdeSettings>(e, [](const OdeSettings& s, const Scene& scene) { check_combination(s, scene); });
-    e.version = std::string("ode ") + dODE_VERSION;
-    e.colour = "#0072B2";  // Okabe-Ito blue
-    return e;
-  }();
+  static const EngineInfo info = engine_entry<OdeSettings>(  // Okabe-Ito blue
+      "ode", EngineRole::Engine, make_ode_simulator, std::string("ode ") + dODE_VERSION, "#0072B2",
+      [](const OdeSettings& s, const Scene& scene) { check_combination(s, scene); });
   return info;
 }
 

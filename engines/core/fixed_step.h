@@ -5,7 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/initial_state.h"
+#include "../../analytic/initial_state.h"
+#include "registry.h"
 #include "simulator.h"
 
 namespace tippe {
@@ -28,8 +29,15 @@ struct FailureLimits {
   double speed_factor = 100.0;     // |w| or |v_G| beyond factor * initial scale -> diverged
 };
 
+// The template of an engine adapter: the stepping loop and every check, the identity (name and
+// version from the engine's EngineInfo) and what an adapter's engine_step leaves behind
+// (contacts, limit hit, solver iterations, notes) are here; an adapter builds its world and
+// implements the protected engine_* calls.
 class FixedStepSimulator : public Simulator {
  public:
+  std::string engine() const override { return info_.name; }
+  std::string version() const override { return info_.version; }
+  std::vector<std::string> notes() const override { return notes_; }
   void advance_to(double t) override;
   Observation observe() const override;
   WorkCounters work() const override { return work_; }
@@ -37,6 +45,7 @@ class FixedStepSimulator : public Simulator {
   double status_time() const override { return status_time_; }
   std::string status_detail() const override { return status_detail_; }
   std::vector<Event> events() const override { return events_; }
+  size_t event_count() const override { return events_.size(); }
   BodyState state() const override { return engine_state(); }
   void set_state(const BodyState& x) override;
 
@@ -50,20 +59,22 @@ class FixedStepSimulator : public Simulator {
   virtual void library_steps(long long n) { bare_steps(n); }
 
  protected:
-  explicit FixedStepSimulator(const Scene& scene);
+  // `info`: the engine's registry entry (engines/core/registry.h), which outlives the simulator.
+  FixedStepSimulator(const Scene& scene, const EngineInfo& info);
   // Must be called by the derived constructor once the engine is built.
   void start(double dt);
 
   virtual void engine_step() = 0;                  // advance the engine by dt
   virtual BodyState engine_state() const = 0;      // state at the engine's current time
-  virtual ContactReport engine_contacts() const = 0;
+  // The contacts the last step left in report_ (an adapter may compute them instead).
+  virtual ContactReport engine_contacts() const { return report_; }
   // Adds a lab-frame force at a lab-frame point for the next step only.
   virtual void apply_force_W(const Vec3& f_W, const Vec3& p_W) = 0;
   // Non-empty when the last step hit an engine limit (e.g. Bullet's pi/4 rotation-per-step clamp).
-  virtual std::string engine_limit_hit() const { return {}; }
+  virtual std::string engine_limit_hit() const { return limit_; }
   // Non-empty when the engine itself failed in the last step (e.g. an ODE internal error).
   virtual std::string engine_failure() const { return {}; }
-  virtual long long engine_solver_iterations() const { return 0; }
+  virtual long long engine_solver_iterations() const { return solver_iterations_; }
   // Writes p_WG, q_WB, v_WG, w_B into the engine at its current time (set_state checks them).
   virtual void engine_set_state(const BodyState& x) = 0;
 
@@ -90,6 +101,12 @@ class FixedStepSimulator : public Simulator {
   // The engine's current time: steps taken times dt (engine_state().t must equal it).
   double time() const { return static_cast<double>(n_steps_) * dt_; }
 
+  // What an adapter's engine_step leaves for the loop to read, and its notes.
+  ContactReport report_;             // the engine's contacts after the step
+  std::string limit_;                // non-empty when the step hit an engine limit
+  long long solver_iterations_ = 0;  // the engine's solver iterations so far
+  std::vector<std::string> notes_;   // approximations in force, as notes() reports them
+
  private:
   void step_once();
   // What the per-step checks keep of a step's end.
@@ -100,6 +117,7 @@ class FixedStepSimulator : public Simulator {
   void track_events(const StepProbe& before, const StepProbe& after);
   void fail(RunStatus s, double t, const std::string& why);
 
+  const EngineInfo& info_;
   Scene scene_;
   BodyModel body_;
   FailureLimits limits_;

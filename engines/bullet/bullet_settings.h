@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "settings.h"
+
 namespace tippe {
 
 // Every setting of the Bullet model that decides accuracy, read from [engines.bullet].
@@ -79,13 +81,13 @@ struct BulletSettings {
 
   template <class V>
   void visit(V& v) {
-    v("timestep", timestep, 1e-8, 1.0);
+    shared_settings::timestep(v, timestep);
     v("substeps", substeps, 1, 100000);
     v("mass_unit", mass_unit, 1e-12, 1e12);
-    v("solver_iterations", solver_iterations, 1, 1000000);
-    v("erp", erp, 0.0, 1.0);
-    v("erp2", erp2, 0.0, 1.0);
-    v("cfm", cfm, 0.0, 1.0);
+    shared_settings::iterations(v, "solver_iterations", solver_iterations);
+    shared_settings::fraction(v, "erp", erp);
+    shared_settings::fraction(v, "erp2", erp2);
+    shared_settings::fraction(v, "cfm", cfm);
     v("split_impulse", split_impulse);
     v("split_impulse_threshold", split_impulse_threshold, -1e6, 0.0);
     v("split_impulse_turn_erp", split_impulse_turn_erp, 0.0, 1.0);
@@ -95,8 +97,8 @@ struct BulletSettings {
     v("gyroscopic", gyroscopic, {"none", "explicit", "implicit_world", "implicit_body"});
     v("friction_directions", friction_directions, 1, 2);
     v("velocity_friction_direction", velocity_friction_direction);
-    v("rolling_mu", rolling_mu, 0.0, 1e15);
-    v("stem_shape", stem_shape, {"capsule", "tip_sphere"});
+    shared_settings::rolling_mu(v, rolling_mu);
+    shared_settings::stem_shape(v, stem_shape);
     v("contact_breaking_threshold", contact_breaking_threshold, 0.0, 1.0);
   }
 };

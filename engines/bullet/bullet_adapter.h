@@ -121,10 +121,6 @@ class BulletSimulator : public FixedStepSimulator {
   BulletSimulator(const BulletSimulator&) = delete;
   BulletSimulator& operator=(const BulletSimulator&) = delete;
 
-  std::string engine() const override { return "bullet"; }
-  std::string version() const override {
-    return "bullet " + std::to_string(BT_BULLET_VERSION / 100) + "." + std::to_string(BT_BULLET_VERSION % 100);
-  }
   SettingsList settings() const override;
   std::vector<std::string> notes() const override;
 
@@ -135,13 +131,10 @@ class BulletSimulator : public FixedStepSimulator {
   void engine_step() override;
   BodyState engine_state() const override;
   void engine_set_state(const BodyState& x) override;
-  ContactReport engine_contacts() const override { return report_; }
   void apply_force_W(const Vec3& f_W, const Vec3& p_W) override;
-  std::string engine_limit_hit() const override { return limit_; }
-  // Bullet does not report the sweeps it made: this counts the configured ones. With
-  // m_leastSquaresResidualThreshold = 0 it stops early only at an exactly zero residual (e.g. no
-  // contact rows), so this is an upper bound that is reached whenever there is a contact.
-  long long engine_solver_iterations() const override { return solver_iterations_; }
+  // solver_iterations_: Bullet does not report the sweeps it made, so it counts the configured
+  // ones. With m_leastSquaresResidualThreshold = 0 it stops early only at an exactly zero residual
+  // (e.g. no contact rows), so this is an upper bound that is reached whenever there is a contact.
 
  private:
   struct PendingForce {
@@ -158,12 +151,8 @@ class BulletSimulator : public FixedStepSimulator {
   BulletSettings settings_;
   double h_ = 0.0;  // internal step
   double mu_ = 0.0, rolling_ = 0.0, spinning_ = 0.0;
-  std::vector<std::string> notes_;
   bullet_detail::BulletObjects o_;
   std::vector<PendingForce> pending_;
-  ContactReport report_;
-  std::string limit_;
-  long long solver_iterations_ = 0;
   long long internal_steps_ = 0;
   long long gyro_dropped_steps_ = 0;  // internal steps in which solve33 dropped w x I w
   double gyro_dropped_first_ = -1.0;  // time of the first such step

@@ -87,17 +87,17 @@ struct DartSettings {
 
   template <class V>
   void visit(V& v) {
-    v("timestep", timestep, 1e-8, 1.0);
+    shared_settings::timestep(v, timestep);
     v("lcp_solver", lcp_solver, {"dantzig", "pgs"});
     v("pgs_fallback", pgs_fallback);
-    v("pgs_iterations", pgs_iterations, 1, 1000000);
+    shared_settings::iterations(v, "pgs_iterations", pgs_iterations);
     v("collision_detector", collision_detector, {"dart", "fcl", "fcl_mesh"});
     v("max_contacts", max_contacts, 1, 1000);
-    v("erp", erp, 0.0, 1.0);
+    shared_settings::fraction(v, "erp", erp);
     v("max_erv", max_erv, 0.0, 1e300);
     v("error_allowance", error_allowance, 0.0, 1e300);
-    v("cfm", cfm, 0.0, 1.0);
-    v("rolling_mu", rolling_mu, 0.0, 1e15);
+    shared_settings::fraction(v, "cfm", cfm);
+    shared_settings::rolling_mu(v, rolling_mu);
   }
 };
 
@@ -112,10 +112,7 @@ class DartSimulator : public FixedStepSimulator {
  public:
   explicit DartSimulator(const Scene& scene);
 
-  std::string engine() const override { return "dart"; }
-  std::string version() const override { return std::string("dart ") + DART_VERSION; }
   SettingsList settings() const override;
-  std::vector<std::string> notes() const override { return notes_; }
   MassReadback mass_properties() const override;
   // World::step alone: the contact parameters written once, then no lock, no parameters and no
   // contact read per step (single-threaded benchmarks only: another world could change them).
@@ -131,9 +128,7 @@ class DartSimulator : public FixedStepSimulator {
   void engine_step() override;
   BodyState engine_state() const override;
   void engine_set_state(const BodyState& x) override;
-  ContactReport engine_contacts() const override { return report_; }
   void apply_force_W(const Vec3& f_W, const Vec3& p_W) override;
-  long long engine_solver_iterations() const override { return solver_iterations_; }
 
  private:
   void read_contacts();
@@ -141,19 +136,16 @@ class DartSimulator : public FixedStepSimulator {
   void write_contact_parameters() const;
 
   DartSettings settings_;
-  std::vector<std::string> notes_;
   dart::simulation::WorldPtr world_;
   dart::dynamics::SkeletonPtr top_, floor_skel_;
   dart::dynamics::BodyNode* body_ = nullptr;
   dart::dynamics::FreeJoint* joint_ = nullptr;
   dart::dynamics::ShapeNode* ball_ = nullptr;
   dart::dynamics::ShapeNode* stem_ = nullptr;
-  ContactReport report_;
-  long long solver_iterations_ = 0;
 };
 
 DartSimulator::DartSimulator(const Scene& scene)
-    : FixedStepSimulator(scene), settings_(read_settings<DartSettings>("dart", scene)) {
+    : FixedStepSimulator(scene, dart_engine_info()), settings_(read_settings<DartSettings>("dart", scene)) {
   using namespace dart;
   const BodyModel& m = body();
   if (!(m.M > 0 && m.A > 0 && m.C > 0 && m.R > 0) || (m.stem && !(m.r > 0 && m.l >= 0)))
@@ -369,16 +361,8 @@ MassReadback DartSimulator::mass_properties() const {
 std::unique_ptr<Simulator> make_dart_simulator(const Scene& scene) { return std::make_unique<DartSimulator>(scene); }
 
 const EngineInfo& dart_engine_info() {
-  static const EngineInfo info = [] {
-    EngineInfo e;
-    e.name = "dart";
-    e.role = EngineRole::Engine;
-    e.make = make_dart_simulator;
-    set_settings_struct<DartSettings>(e);
-    e.version = std::string("dart ") + DART_VERSION;
-    e.colour = "#E69F00";  // Okabe-Ito orange
-    return e;
-  }();
+  static const EngineInfo info = engine_entry<DartSettings>(  // Okabe-Ito orange
+      "dart", EngineRole::Engine, make_dart_simulator, std::string("dart ") + DART_VERSION, "#E69F00");
   return info;
 }
 

@@ -1,6 +1,7 @@
 // The one interface every simulator (the analytic reference and each engine) implements.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <utility>
@@ -30,8 +31,12 @@ struct WorkCounters {
   long long steps = 0;            // accepted integrator or engine steps
   long long rhs_evaluations = 0;  // analytic: right-hand-side calls; engines: steps
   long long solver_iterations = 0;
-  double wall_seconds = 0.0;      // of advance_to calls only
-  double cpu_seconds = 0.0;       // CPU time of the calling thread in advance_to
+  // The run's time, filled by run_simulator (harness/measure/run.cpp), never by a simulator: the
+  // span of its sampling loop (every advance_to and the sampling between them), each clock read
+  // once at either end. Per advance_to, a thread CPU clock read (a system call) cost more than a
+  // sample.
+  double wall_seconds = 0.0;
+  double cpu_seconds = 0.0;       // CPU time of the calling thread
 };
 
 // Mass properties as the engine holds them, read back from its own objects (never the scene's
@@ -67,6 +72,8 @@ class Simulator {
   virtual double status_time() const = 0;
   virtual std::string status_detail() const = 0;
   virtual std::vector<Event> events() const = 0;
+  // events().size() without the copy (a run asks after every sample).
+  virtual size_t event_count() const { return events().size(); }
   virtual SettingsList settings() const = 0;
   // Notes on approximations in force (e.g. "rolling approximated by mu = 1e3").
   virtual std::vector<std::string> notes() const { return {}; }

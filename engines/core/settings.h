@@ -11,7 +11,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "../analytic/scene.h"
+#include "../../analytic/scene.h"
 #include "simulator.h"
 
 namespace tippe {
@@ -164,5 +164,30 @@ SettingsList list_settings(Settings s) {
   s.visit(l);
   return l.list;
 }
+
+// The keys several engines share, one bound per meaning: an engine's `visit` calls these for
+// them, so a value one engine accepts no other refuses for the same key.
+namespace shared_settings {
+
+// The fixed step, in the scene's time unit (s, or the dimensionless unit): from 1e-8 (below, a
+// run of the shipped horizons takes 1e9 steps and more) to 0.1, the coarsest step any shipped
+// ladder or boundary search tries (harness/sweeps/) and the bound ODE and MuJoCo always had.
+// Bullet and DART accepted up to 1, where the shortest shipped run (3 s) is three steps.
+template <class V>
+void timestep(V& v, double& field) { v("timestep", field, 1e-8, 0.1); }
+// A solver's iteration budget (ODE's quickstep, MuJoCo's, Bullet's, DART's PGS).
+template <class V>
+void iterations(V& v, const char* key, int& field) { v(key, field, 1, 1000000); }
+// A fraction of an error or a softness corrected per step: ERP, CFM and their variants.
+template <class V>
+void fraction(V& v, const char* key, double& field) { v(key, field, 0.0, 1.0); }
+// The friction coefficient an engine's contact stands in for rolling with (scene friction "rolling").
+template <class V>
+void rolling_mu(V& v, double& field) { v("rolling_mu", field, 0.0, 1e15); }
+// The stem's collision shape: the capsule, or the sphere of its tip alone.
+template <class V>
+void stem_shape(V& v, std::string& field) { v("stem_shape", field, {"capsule", "tip_sphere"}); }
+
+}  // namespace shared_settings
 
 }  // namespace tippe

@@ -2,11 +2,10 @@
 #include <boost/version.hpp>
 #include <sstream>
 
-#include "../analytic/reference_model.h"
+#include "../../analytic/reference_model.h"
 #include "adapters.h"
 #include "registry.h"
 #include "settings.h"
-#include "timing.h"
 
 namespace tippe {
 
@@ -51,10 +50,7 @@ class AnalyticSimulator final : public Simulator {
 
   std::string engine() const override { return "analytic"; }
   std::string version() const override { return reference_version(); }
-  void advance_to(double t) override {
-    WorkTimer timer(work_.wall_seconds, work_.cpu_seconds);
-    model_->advance_to(t);
-  }
+  void advance_to(double t) override { model_->advance_to(t); }
   Observation observe() const override {
     const BodyModel& b = model_->body();
     Observation o = observe_kinematics(b, model_->state());
@@ -73,7 +69,7 @@ class AnalyticSimulator final : public Simulator {
     return o;
   }
   WorkCounters work() const override {
-    WorkCounters w = work_;
+    WorkCounters w;
     w.steps = earlier_steps_ + model_->steps();
     w.rhs_evaluations = earlier_rhs_ + model_->rhs_evaluations();
     return w;
@@ -116,6 +112,7 @@ class AnalyticSimulator final : public Simulator {
     for (const auto& e : model_->events()) out.push_back({e.name, e.time, e.detail, e.value});
     return out;
   }
+  size_t event_count() const override { return earlier_events_.size() + model_->events().size(); }
   std::vector<std::string> notes() const override {
     if (scene_.run.alias_keys.empty()) return {};
     std::string keys;
@@ -132,7 +129,6 @@ class AnalyticSimulator final : public Simulator {
  private:
   Scene scene_;
   std::unique_ptr<ReferenceModel> model_;
-  WorkCounters work_;
   std::vector<Event> earlier_events_;  // of the runs before the last set_state
   long long earlier_steps_ = 0, earlier_rhs_ = 0;
 };
@@ -169,14 +165,10 @@ void adopt_reference_settings(Scene& scene) {
 
 const EngineInfo& analytic_engine_info() {
   static const EngineInfo info = [] {
-    EngineInfo e;
-    e.name = "analytic";
-    e.role = EngineRole::Reference;
-    e.make = make_analytic_simulator;
-    set_settings_struct<AnalyticSettings>(e);
+    // Okabe-Ito reddish purple (the plot colours are the colour-blind-safe palette's)
+    EngineInfo e = engine_entry<AnalyticSettings>("analytic", EngineRole::Reference, make_analytic_simulator,
+                                                  reference_version(), "#CC79A7");
     e.adopt = adopt_reference_settings;
-    e.version = reference_version();
-    e.colour = "#CC79A7";  // Okabe-Ito reddish purple (colour-blind-safe palette)
     return e;
   }();
   return info;

@@ -4,6 +4,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "settings.h"
@@ -40,6 +41,29 @@ void set_settings_struct(EngineInfo& info, std::function<void(const Settings&, c
   };
   info.default_settings = [] { return list_settings(Settings{}); };
 }
+
+// One registry entry from a settings struct with `visit` (validate and default_settings as
+// set_settings_struct makes them); `check` adds checks of combinations beyond each key's bounds.
+// An adapter's NAME_engine_info() returns one of these, made once.
+template <class Settings>
+EngineInfo engine_entry(std::string name, EngineRole role, std::function<std::unique_ptr<Simulator>(const Scene&)> make,
+                        std::string version, std::string colour,
+                        std::function<void(const Settings&, const Scene&)> check = nullptr) {
+  EngineInfo e;
+  e.name = std::move(name);
+  e.role = role;
+  e.make = std::move(make);
+  set_settings_struct<Settings>(e, std::move(check));
+  e.version = std::move(version);
+  e.colour = std::move(colour);
+  return e;
+}
+
+// Each simulator's entry, defined in its folder: the reference's and one per line of engine_list.h.
+const EngineInfo& analytic_engine_info();
+#define TIPPE_ENGINE(name) const EngineInfo& name##_engine_info();
+#include "engine_list.h"
+#undef TIPPE_ENGINE
 
 // Every registered simulator, the reference first, then the engines in registration order.
 const std::vector<EngineInfo>& engine_registry();

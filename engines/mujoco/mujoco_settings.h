@@ -4,7 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/scene.h"
+#include "../../analytic/scene.h"
+#include "settings.h"
 
 namespace tippe {
 
@@ -79,12 +80,12 @@ struct MujocoSettings {
 
   template <class V>
   void visit(V& v) {
-    v("timestep", timestep, 1e-8, 0.1);
+    shared_settings::timestep(v, timestep);
     v("integrator", integrator, {"Euler", "RK4", "implicit"});
     v("cone", cone, {"elliptic", "pyramidal"});
     v("impratio", impratio, 1e-6, 1e6);
     v("solver", solver, {"Newton", "CG", "PGS"});
-    v("iterations", iterations, 1, 1000000);
+    shared_settings::iterations(v, "iterations", iterations);
     v("tolerance", tolerance, 0.0, 1.0);
     v("noslip_iterations", noslip_iterations, 0, 1000000);
     v("noslip_iterations_rolling", noslip_iterations_rolling, 0, 1000000);
@@ -92,9 +93,9 @@ struct MujocoSettings {
     v("solref", solref, 2);
     v("solimp", solimp, 5);
     v("condim", condim, 0, 6);
-    v("rolling_mu", rolling_mu, 0.0, 1e15);
+    shared_settings::rolling_mu(v, rolling_mu);
     v("body_frame", body_frame, {"com", "ball_centre"});
-    v("stem_shape", stem_shape, {"capsule", "tip_sphere"});
+    shared_settings::stem_shape(v, stem_shape);
     v("margin", margin, 0.0, 1.0);
     v("model", model);
     v("body", body);

@@ -26,7 +26,7 @@ void TopWorld::solveConstraints(btContactSolverInfo& info) {
 }
 
 BulletSimulator::BulletSimulator(const Scene& scene)
-    : FixedStepSimulator(scene), settings_(read_settings<BulletSettings>("bullet", scene)) {
+    : FixedStepSimulator(scene, bullet_engine_info()), settings_(read_settings<BulletSettings>("bullet", scene)) {
   const BodyModel& m = body();
   if (!(m.M > 0 && m.A > 0 && m.C > 0 && m.R > 0) || (m.stem && !(m.r > 0 && m.l >= 0)))
     throw std::invalid_argument("bullet: needs M, A, C, R > 0 (and r > 0, l >= 0 with a stem)");

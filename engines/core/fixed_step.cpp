@@ -7,7 +7,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "timing.h"
 
 namespace tippe {
 
@@ -23,8 +22,8 @@ const char* to_string(RunStatus s) {
   return "?";
 }
 
-FixedStepSimulator::FixedStepSimulator(const Scene& scene)
-    : scene_(scene), body_(BodyModel::from_scene(scene)) {}
+FixedStepSimulator::FixedStepSimulator(const Scene& scene, const EngineInfo& info)
+    : info_(info), scene_(scene), body_(BodyModel::from_scene(scene)) {}
 
 void FixedStepSimulator::start(double dt) {
   dt_ = dt;
@@ -118,7 +117,6 @@ void FixedStepSimulator::fail(RunStatus s, double t, const std::string& why) {
 }
 
 void FixedStepSimulator::advance_to(double t) {
-  WorkTimer timer(work_.wall_seconds, work_.cpu_seconds);
   // Steps whose end lies within half a step of t count as reaching t.
   while (status_ == RunStatus::Ok && (static_cast<double>(n_steps_) + 0.5) * dt_ <= t) step_once();
 }

@@ -66,10 +66,7 @@ class MujocoSimulator : public FixedStepSimulator {
   MujocoSimulator(const MujocoSimulator&) = delete;
   MujocoSimulator& operator=(const MujocoSimulator&) = delete;
 
-  std::string engine() const override { return "mujoco"; }
-  std::string version() const override { return std::string("mujoco ") + mj_versionString(); }
   SettingsList settings() const override;
-  std::vector<std::string> notes() const override { return notes_; }
 
   MujocoModelReadback readback() const;
   std::vector<double> qpos() const { return std::vector<double>(d_->qpos, d_->qpos + m_->nq); }
@@ -84,10 +81,7 @@ class MujocoSimulator : public FixedStepSimulator {
   void engine_step() override;
   BodyState engine_state() const override;
   void engine_set_state(const BodyState& x) override;
-  ContactReport engine_contacts() const override { return report_; }
   void apply_force_W(const Vec3& f_W, const Vec3& p_W) override;
-  std::string engine_limit_hit() const override { return limit_; }
-  long long engine_solver_iterations() const override { return solver_iterations_; }
 
  public:
   MassReadback mass_properties() const override;
@@ -100,7 +94,6 @@ class MujocoSimulator : public FixedStepSimulator {
 
   MujocoSettings settings_;
   int condim_ = 0;
-  std::vector<std::string> notes_;
   MujocoHandles mj_;
   // Aliases of mj_'s handles, for brevity.
   mjModel* m_ = nullptr;
@@ -116,16 +109,13 @@ class MujocoSimulator : public FixedStepSimulator {
   Vec3 p_FG_F_ = Vec3::Zero();
   bool keyframe_start_ = false;
   MjTopIds ids_;
-  ContactReport report_;
-  std::string limit_;
   // MuJoCo met a NaN or |x| > mjMAXVAL in qpos, qvel or qacc and reset mjData to the model's
   // qpos0: the engine's state is lost, so it is reported as non-finite (a diverged run).
   std::string bad_state_;
-  long long solver_iterations_ = 0;
 };
 
 MujocoSimulator::MujocoSimulator(const Scene& scene)
-    : FixedStepSimulator(scene), settings_(read_checked_settings(scene)) {
+    : FixedStepSimulator(scene, mujoco_engine_info()), settings_(read_checked_settings(scene)) {
   install_warning_handler();
   if (!settings_.model.empty()) {
     init_user_model(scene);
@@ -473,14 +463,10 @@ void validate_mujoco_settings(const Scene& scene) {
 
 const EngineInfo& mujoco_engine_info() {
   static const EngineInfo info = [] {
-    EngineInfo e;
-    e.name = "mujoco";
-    e.role = EngineRole::Engine;
-    e.make = make_mujoco_simulator;
+    EngineInfo e = engine_entry<MujocoSettings>(  // Okabe-Ito bluish green
+        "mujoco", EngineRole::Engine, make_mujoco_simulator, std::string("mujoco ") + mj_versionString(), "#009E73");
+    // Its checks and, for the user's own model, MuJoCo compiling it.
     e.validate = validate_mujoco_settings;
-    e.default_settings = [] { return list_settings(MujocoSettings{}); };
-    e.version = std::string("mujoco ") + mj_versionString();
-    e.colour = "#009E73";  // Okabe-Ito bluish green
     return e;
   }();
   return info;

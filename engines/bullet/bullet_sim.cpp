@@ -134,16 +134,9 @@ std::unique_ptr<Simulator> make_bullet_simulator(const Scene& scene) {
 void validate_bullet_settings(const Scene& scene) { (void)read_settings<BulletSettings>("bullet", scene); }
 
 const EngineInfo& bullet_engine_info() {
-  static const EngineInfo info = [] {
-    EngineInfo e;
-    e.name = "bullet";
-    e.role = EngineRole::Engine;
-    e.make = make_bullet_simulator;
-    set_settings_struct<BulletSettings>(e);
-    e.version = "bullet " + std::to_string(BT_BULLET_VERSION / 100) + "." + std::to_string(BT_BULLET_VERSION % 100);
-    e.colour = "#D55E00";  // Okabe-Ito vermillion
-    return e;
-  }();
+  static const EngineInfo info = engine_entry<BulletSettings>(  // Okabe-Ito vermillion
+      "bullet", EngineRole::Engine, make_bullet_simulator,
+      "bullet " + std::to_string(BT_BULLET_VERSION / 100) + "." + std::to_string(BT_BULLET_VERSION % 100), "#D55E00");
   return info;
 }
 
