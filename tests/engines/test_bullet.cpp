@@ -253,10 +253,13 @@ TEST(Bullet, DrillingRemovesSpin) {
   for (double rf : r.point_rolling_friction) EXPECT_EQ(rf, 1e-12);
 }
 
-// A step far beyond Bullet's rotation limit ends the run with a status, never a crash.
+// A step far beyond Bullet's rotation limit ends the run with a status, never a crash. The
+// largest step any engine accepts (0.1, shared_settings::timestep) at spin 20: |omega| h = 2,
+// far beyond Bullet's pi/4 (at spin 5 the step was 0.5 when Bullet still accepted it).
 TEST(Bullet, HugeStepEndsAsClampedOrDiverged) {
   Scene scene = dimensionless_scene();
-  scene.engines["bullet"]["timestep"] = 0.5;
+  scene.initial.spin = 20.0;
+  scene.engines["bullet"]["timestep"] = 0.1;
   const auto sim = make_simulator("bullet", scene);
   sim->advance_to(scene.run.duration);
   const RunStatus s = sim->status();
