@@ -229,6 +229,13 @@ void SimbodySimulator::make_notes() {
   os << "Hunt-Crossley compliant contact (Simbody's Hertz sphere-on-half-space force, stiffness " << settings_.stiffness
      << ", dissipation " << settings_.dissipation << ") on top and floor alike";
   notes_.push_back(os.str());
+  // The Hertz depth that carries the weight on the ball: the start is at zero depth, so the top
+  // drops onto it and rings (Hunt-Crossley damping is proportional to the small depth rate).
+  const double E_eff = settings_.stiffness / std::pow(2.0, 1.5);
+  const double x0 = std::pow(3 * body_.M * scene_.gravity / (4 * E_eff * std::sqrt(body_.R)), 2.0 / 3.0);
+  os.str("");
+  os << "compliant contact: the top rests " << x0 / body_.R << " R deep on its ball and starts at zero depth";
+  notes_.push_back(os.str());
   os.str("");
   os << "variable-step " << settings_.integrator << " integration to relative accuracy " << settings_.accuracy
      << " (Simbody's own step control; no time step)";
