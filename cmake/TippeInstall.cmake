@@ -56,7 +56,8 @@ install(FILES ${PROJECT_BINARY_DIR}/tippeConfig.cmake ${PROJECT_BINARY_DIR}/tipp
 if(TIPPE_ENGINES)
   set(TIPPE_PC_REQUIRES "eigen3 tomlplusplus nlohmann_json bullet-float64 ode")
   # DART links as its imported target `dart` (libdart and its FCL); the .pc names them directly.
-  set(TIPPE_PC_LIBS "-lmujoco -ldart -lfcl")
+  # Simbody (engines/simbody/) likewise: its three libraries, no .pc of its own in Debian.
+  set(TIPPE_PC_LIBS "-lmujoco -ldart -lfcl -lSimTKsimbody -lSimTKmath -lSimTKcommon")
 else()
   set(TIPPE_PC_REQUIRES "eigen3 tomlplusplus nlohmann_json")
   set(TIPPE_PC_LIBS "")

@@ -20,6 +20,14 @@ const std::string kScene = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/extr
 // The fraction of E0 a run has lost by its end.
 double energy_lost(const RunRecord& r) { return (r.energy_initial - r.energy_final) / r.energy_initial; }
 
+// "engines.E.timestep=dt" for an engine with a time step; nothing for one without (a
+// variable-step engine such as Simbody chooses its own steps and runs at its defaults).
+std::vector<std::string> step_override(const std::string& engine, const std::string& dt) {
+  for (const auto& [key, value] : engine_info(engine).default_settings())
+    if (key == "timestep") return {"engines." + engine + ".timestep=" + dt};
+  return {};
+}
+
 class TwoContactFriction : public ::testing::TestWithParam<std::string> {};
 
 // extremes/tilt_near_pi starts inverted with ball and stem both on the floor under the viscous law
@@ -34,7 +42,7 @@ TEST_P(TwoContactFriction, EnergyLostWithBallAndStemDownMatchesTheReference) {
   const Scene reference_scene = load_scene(kScene);
   const RunRecord ref = run_scene(reference_scene, "analytic", nullptr);
   ASSERT_EQ(ref.status, "ok") << ref.status_detail;
-  const Scene scene = load_scene(kScene, {"engines." + engine + ".timestep=2e-5"});
+  const Scene scene = load_scene(kScene, step_override(engine, "2e-5"));
   const RunRecord run = run_scene(scene, engine, nullptr);
   ASSERT_EQ(run.status, "ok") << run.status_detail;
   EXPECT_GT(energy_lost(ref), 0.8) << "the scene no longer tests two contacts";
@@ -57,9 +65,12 @@ struct SurfaceSink : SampleSink {
   std::vector<std::pair<double, Surface>> samples;
   void write(const Observation& o) override { samples.emplace_back(o.state.t, o.surface); }
 };
-TEST_P(TwoContactFriction, SamplesWithBallAndStemDownAreOnBoth) {
+class TwoContactSamples : public ::testing::TestWithParam<std::string> {};
+TEST_P(TwoContactSamples, SamplesWithBallAndStemDownAreOnBoth) {
   const std::string engine = GetParam();
-  const Scene scene = load_scene(kScene, {"engines." + engine + ".timestep=1e-4", "run.duration=0.45"});
+  std::vector<std::string> overrides = step_override(engine, "1e-4");
+  overrides.push_back("run.duration=0.45");
+  const Scene scene = load_scene(kScene, overrides);
   SurfaceSink sink;
   const RunRecord run = run_scene(scene, engine, &sink);
   ASSERT_EQ(run.status, "ok") << run.status_detail;
@@ -109,6 +120,17 @@ INSTANTIATE_TEST_SUITE_P(Engines, TwoContactFriction, ::testing::ValuesIn(engine
                          [](const auto& info) { return info.param; });
 
 INSTANTIATE_TEST_SUITE_P(Engines, TwoContactsTouch, ::testing::Values("ode", "bullet", "mujoco"),
+                         [](const auto& info) { return info.param; });
+
+INSTANTIATE_TEST_SUITE_P(Engines, TwoContactSamples, ::testing::Values("ode", "bullet", "mujoco", "dart"),
+                         [](const auto& info) { return info.param; });
+// Finding, kept disabled: Simbody's compliant contact (Hunt-Crossley, c = 0.5, its default) has
+// no two-contact phase to label here. When the ball lands its stem at t = 0.2837 s, ball and stem
+// are down together for 0.1 ms and the top then hops on its stem: contacts of ~0.25 ms every
+// ~10 ms with none between (restitution ~1 at these landing speeds, where the reference's impact
+// is plastic), so 0 of 451 samples have both down. The energy it loses over the 2 s (the test
+// above) still matches the reference's within 0.03 of E0.
+INSTANTIATE_TEST_SUITE_P(DISABLED_Simbody, TwoContactSamples, ::testing::Values("simbody"),
                          [](const auto& info) { return info.param; });
 // Finding, kept disabled: DART's detectors have no contact margin (a contact exists at a gap
 // <= 0 only) and at the exact switching tilt the stem tip's gap comes out round-off above 0, so

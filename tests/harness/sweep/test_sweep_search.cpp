@@ -530,9 +530,10 @@ TEST(SweepSearchShipped, BoundariesCoverEveryEngineAndEveryShippedScene) {
     EXPECT_TRUE(regime.count(e)) << e << " has no regime search";
     EXPECT_TRUE(inversion.count(e)) << e << " has no inversion-time search";
   }
-  // Planned up front: the coarse grids (5 values over 4 decades) of 12 scenes x 4 engines' regime
-  // searches and 6 x 4 others.
-  EXPECT_EQ(plan.planned, 5u * (12 * 4 + 6 * 4));
+  // Planned up front: the coarse grids (5 values over 4 decades) of 12 scenes x every engine's
+  // regime search and 6 x every engine's inversion search.
+  const size_t engines = engine_names().size();
+  EXPECT_EQ(plan.planned, 5u * (12 * engines + 6 * engines));
 }
 
 TEST(SweepSearchInput, SetupScenesNameScenesOfTheSweep) {

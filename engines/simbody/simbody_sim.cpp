@@ -1,0 +1,488 @@
+// Simbody 3.7 adapter: one free MobilizedBody at G with the ball and the stem tip as Hunt-Crossley spheres on a half-space, integrated with error control.
+//
+// Unlike the four fixed-step engines (engines/fixed_step.h), Simbody has no step to set: its
+// integrators choose their own steps to an accuracy. advance_to(t) integrates to exactly t, and
+// the checks every engine gets (events, divergence, penetration) run after each accepted internal
+// step, as the shared fixed-step loop runs them after each fixed step.
+#include <Simbody.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "../../analytic/initial_state.h"
+#include "fixed_step.h"  // FailureLimits: the same divergence limits as every engine
+#include "registry.h"
+#include "settings.h"
+#include "simbody_settings.h"
+
+namespace tippe {
+namespace {
+
+std::string simbody_version() {
+  // Debian's libsimbody-dev 3.7; the headers carry no version macro of their own.
+  return "simbody 3.7";
+}
+
+Eigen::Vector3d to_eigen(const SimTK::Vec3& v) { return {v[0], v[1], v[2]}; }
+SimTK::Vec3 to_simtk(const Eigen::Vector3d& v) { return SimTK::Vec3(v.x(), v.y(), v.z()); }
+
+// The two contact spheres of the body, in the body frame at G: the ball about O = G + d e_Z and
+// the stem tip about P = G + (d + l) e_Z (on a plane the tip sphere is the capsule O-P's contact:
+// its O end lies inside the ball).
+struct SphereSpec {
+  SimTK::Vec3 centre_B;
+  double radius = 0.0;
+};
+
+// The source's viscous law F_t = -k v_C at every sphere that penetrates the floor, each at its
+// lowest point with that material point's horizontal velocity. A force element in Simbody's
+// right-hand side: evaluated at every stage of every step, so the integrator's accuracy covers it
+// (the fixed-step engines can only hold it constant over a step).
+class ViscousContactForce : public SimTK::Force::Custom::Implementation {
+ public:
+  ViscousContactForce(const SimTK::MobilizedBody& top, std::vector<SphereSpec> spheres, double k)
+      : top_(top), spheres_(std::move(spheres)), k_(k) {}
+  void calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::SpatialVec>& body_forces, SimTK::Vector_<SimTK::Vec3>&,
+                 SimTK::Vector&) const override {
+    const SimTK::Transform& X = top_.getBodyTransform(s);
+    const SimTK::SpatialVec& V = top_.getBodyVelocity(s);
+    for (const SphereSpec& sp : spheres_) {
+      const SimTK::Vec3 centre = X * sp.centre_B;
+      if (centre[2] - sp.radius >= 0) continue;
+      const SimTK::Vec3 p = centre - SimTK::Vec3(0, 0, sp.radius);
+      SimTK::Vec3 v_C = V[1] + V[0] % (p - X.p());
+      v_C[2] = 0;
+      top_.applyForceToBodyPoint(s, ~X * p, -k_ * v_C, body_forces);
+    }
+  }
+  SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
+
+ private:
+  SimTK::MobilizedBody top_;
+  std::vector<SphereSpec> spheres_;
+  double k_;
+};
+
+// What Simbody's contact subsystem reports for a state (as the fixed-step engines' ContactReport).
+struct Contacts {
+  bool ball = false, stem = false;
+  double normal_force = 0.0, normal_force_ball = 0.0, normal_force_stem = 0.0;
+  bool point_valid = false;
+  Eigen::Vector3d p_WC = Eigen::Vector3d::Zero();
+};
+
+class SimbodySimulator : public Simulator {
+ public:
+  explicit SimbodySimulator(const Scene& scene);
+
+  std::string engine() const override { return "simbody"; }
+  std::string version() const override { return simbody_version(); }
+  void advance_to(double t) override;
+  Observation observe() const override;
+  BodyState state() const override { return read_state(integ_->getState()); }
+  void set_state(const BodyState& x) override;
+  MassReadback mass_properties() const override;
+  WorkCounters work() const override;
+  RunStatus status() const override { return status_; }
+  double status_time() const override { return status_time_; }
+  std::string status_detail() const override { return status_detail_; }
+  std::vector<Event> events() const override { return events_; }
+  SettingsList settings() const override { return list_settings(settings_); }
+  std::vector<std::string> notes() const override { return notes_; }
+
+ private:
+  struct StepProbe {
+    BodyState state;
+    double cos_theta = 1.0, gap_ball = 0.0, gap_stem = 0.0;
+  };
+  BodyState read_state(const SimTK::State& s) const;
+  Contacts read_contacts(const SimTK::State& s) const;
+  StepProbe probe(const BodyState& x) const;
+  void after_step();
+  void track_events(const StepProbe& a, const StepProbe& b);
+  void fail(RunStatus s, double t, const std::string& why);
+  void make_integrator();
+  void make_notes();
+
+  Scene scene_;
+  BodyModel body_;
+  SimbodySettings settings_;
+  SimbodyFriction friction_;
+  std::vector<std::string> notes_;
+
+  SimTK::MultibodySystem system_;
+  SimTK::SimbodyMatterSubsystem matter_;
+  SimTK::GeneralForceSubsystem forces_;
+  SimTK::ContactTrackerSubsystem tracker_;
+  SimTK::CompliantContactSubsystem contact_;
+  SimTK::MobilizedBody::Free top_;
+  SimTK::ContactSurfaceIndex ball_surface_, stem_surface_;
+  std::unique_ptr<SimTK::Integrator> integ_;
+
+  FailureLimits limits_;
+  double e0_ = 0.0, speed_scale_ = 0.0;
+  RunStatus status_ = RunStatus::Ok;
+  double status_time_ = 0.0;
+  std::string status_detail_;
+  std::vector<Event> events_;
+  WorkCounters work_;
+  long long realizations_before_ = 0, iterations_before_ = 0;  // of integrators replaced by set_state
+  StepProbe last_;
+  Contacts report_;
+  bool inverted_ = false, stem_touched_ = false;
+  Surface contact_surface_ = Surface::Ball;
+};
+
+SimbodySimulator::SimbodySimulator(const Scene& scene)
+    : scene_(scene),
+      body_(BodyModel::from_scene(scene)),
+      settings_(read_settings<SimbodySettings>("simbody", scene)),
+      friction_(simbody_friction(settings_, scene.contact)),
+      matter_(system_),
+      forces_(system_),
+      tracker_(system_),
+      contact_(system_, tracker_) {
+  using namespace SimTK;
+  const BodyModel& m = body_;
+  if (!(m.M > 0 && m.A > 0 && m.C > 0 && m.R > 0) || (m.stem && !(m.r > 0 && m.l >= 0)))
+    throw std::invalid_argument("simbody: needs M, A, C, R > 0 (and r > 0, l >= 0 with a stem)");
+  // The scales as used, in the settings the run lists.
+  if (settings_.length_scale == 0) settings_.length_scale = m.R;
+  if (settings_.time_scale == 0) settings_.time_scale = scene.gravity > 0 ? std::sqrt(m.R / scene.gravity) : 1.0;
+  settings_.static_friction = friction_.us;
+  settings_.dynamic_friction = friction_.ud;
+  settings_.viscous_friction = friction_.uv;
+  system_.setDefaultLengthScale(settings_.length_scale);
+  system_.setDefaultTimeScale(settings_.time_scale);
+
+  Force::UniformGravity(forces_, matter_, SimTK::Vec3(0, 0, -scene.gravity));
+  contact_.setTransitionVelocity(settings_.transition_velocity);
+  const ContactMaterial material(settings_.stiffness, settings_.dissipation, friction_.us, friction_.ud, friction_.uv);
+
+  // The floor z = 0: Simbody's half-space is x > 0 of its frame (outward normal -x), so its
+  // frame is Ground turned by pi/2 about y (x -> -z).
+  matter_.Ground().updBody().addContactSurface(Transform(Rotation(Pi / 2, YAxis), SimTK::Vec3(0)),
+                                               ContactSurface(ContactGeometry::HalfSpace(), material));
+
+  // The top: one body whose frame is the principal frame at G, its mass properties the scene's
+  // (never computed from the shapes). Ball and tip in one clique: they never touch each other.
+  Body::Rigid body(SimTK::MassProperties(m.M, SimTK::Vec3(0), Inertia(m.A, m.A, m.C)));
+  const ContactCliqueId clique = ContactSurface::createNewContactClique();
+  std::vector<SphereSpec> spheres{{SimTK::Vec3(0, 0, m.z_O()), m.R}};
+  const int ball = body.addContactSurface(Transform(spheres[0].centre_B),
+                                          ContactSurface(ContactGeometry::Sphere(m.R), material).joinClique(clique));
+  int stem = -1;
+  if (m.stem) {
+    spheres.push_back({SimTK::Vec3(0, 0, m.z_P()), m.r});
+    stem = body.addContactSurface(Transform(spheres[1].centre_B),
+                                  ContactSurface(ContactGeometry::Sphere(m.r), material).joinClique(clique));
+  }
+  top_ = MobilizedBody::Free(matter_.Ground(), Transform(), body, Transform());
+  if (friction_.bench_viscous) Force::Custom(forces_, new ViscousContactForce(top_, spheres, scene.contact.k));
+
+  system_.realizeTopology();
+  ball_surface_ = tracker_.getContactSurfaceIndex(top_, ball);
+  if (stem >= 0) stem_surface_ = tracker_.getContactSurfaceIndex(top_, stem);
+  State s = system_.getDefaultState();
+  const BodyState x0 = scene_initial_state(scene);
+  top_.setQToFitTransform(s, Transform(Rotation(Quaternion(x0.q_WB.w(), x0.q_WB.x(), x0.q_WB.y(), x0.q_WB.z())),
+                                       to_simtk(x0.p_WG)));
+  top_.setUToFitVelocity(s, SpatialVec(to_simtk(x0.q_WB * x0.w_B), to_simtk(x0.v_WG)));
+  system_.realize(s, Stage::Velocity);
+  make_integrator();
+  integ_->initialize(s);
+
+  const BodyState y0 = read_state(integ_->getState());
+  last_ = probe(y0);
+  report_ = read_contacts(integ_->getState());
+  e0_ = energy(body_, y0);
+  speed_scale_ = std::max({y0.w_B.norm(), y0.v_WG.norm() / m.R, std::sqrt(m.g / m.R), 1e-12});
+  make_notes();
+}
+
+void SimbodySimulator::make_integrator() {
+  using namespace SimTK;
+  const std::string& k = settings_.integrator;
+  if (k == "rk_merson") integ_ = std::make_unique<RungeKuttaMersonIntegrator>(system_);
+  else if (k == "rk3") integ_ = std::make_unique<RungeKutta3Integrator>(system_);
+  else if (k == "rk2") integ_ = std::make_unique<RungeKutta2Integrator>(system_);
+  else if (k == "euler") integ_ = std::make_unique<ExplicitEulerIntegrator>(system_);
+  else if (k == "verlet") integ_ = std::make_unique<VerletIntegrator>(system_);
+  else integ_ = std::make_unique<CPodesIntegrator>(system_, CPodes::BDF, CPodes::Newton);
+  integ_->setAccuracy(settings_.accuracy);
+  if (settings_.max_step > 0) integ_->setMaximumStepSize(settings_.max_step);
+  // Every state the bench sees is the end of an accepted step: no interpolated report states
+  // (a report time ends a step), and control comes back after each step for the checks.
+  integ_->setAllowInterpolation(false);
+  integ_->setReturnEveryInternalStep(true);
+}
+
+void SimbodySimulator::make_notes() {
+  std::ostringstream os;
+  os << "Hunt-Crossley compliant contact (Simbody's Hertz sphere-on-half-space force, stiffness " << settings_.stiffness
+     << ", dissipation " << settings_.dissipation << ") on top and floor alike";
+  notes_.push_back(os.str());
+  // The Hertz depth that carries the weight on the ball: the start is at zero depth, so the top
+  // drops onto it and rings (Hunt-Crossley damping is proportional to the small depth rate).
+  const double E_eff = settings_.stiffness / std::pow(2.0, 1.5);
+  const double x0 = std::pow(3 * body_.M * scene_.gravity / (4 * E_eff * std::sqrt(body_.R)), 2.0 / 3.0);
+  os.str("");
+  os << "compliant contact: the top rests " << x0 / body_.R << " R deep on its ball and starts at zero depth";
+  notes_.push_back(os.str());
+  os.str("");
+  os << "variable-step " << settings_.integrator << " integration to relative accuracy " << settings_.accuracy
+     << " (Simbody's own step control; no time step)";
+  notes_.push_back(os.str());
+  const ContactSpec& c = scene_.contact;
+  os.str("");
+  switch (c.friction) {
+    case FrictionLaw::Coulomb:
+      os << "Coulomb friction as Simbody's law with static = dynamic = mu = " << c.mu
+         << ", regularized below the transition velocity " << settings_.transition_velocity
+         << ": a rolling contact creeps instead of sticking";
+      break;
+    case FrictionLaw::Gliding:
+      os << "gliding friction -mu F_n v_C as Simbody's viscous friction coefficient " << c.mu
+         << " (static and dynamic 0), F_n the Hunt-Crossley normal force, in Simbody's own contact force";
+      break;
+    case FrictionLaw::Viscous:
+      os << "viscous friction applied by the bench as a force element (Force::Custom, in Simbody's right-hand side) at "
+            "the lowest point of each penetrating sphere; Simbody's contact friction 0";
+      break;
+    case FrictionLaw::Rolling:
+      os << "rolling approximated by Coulomb friction with mu = " << settings_.rolling_mu << ", regularized below "
+         << settings_.transition_velocity;
+      break;
+    case FrictionLaw::None: break;
+  }
+  if (!os.str().empty()) notes_.push_back(os.str());
+  SimbodySettings unset = settings_;
+  unset.static_friction = unset.dynamic_friction = unset.viscous_friction = -1.0;
+  const SimbodyFriction law = simbody_friction(unset, c);
+  if (law.us != friction_.us || law.ud != friction_.ud || law.uv != friction_.uv) {
+    os.str("");
+    os << "friction coefficients set in [engines.simbody] in place of the scene's law: static " << friction_.us
+       << ", dynamic " << friction_.ud << ", viscous " << friction_.uv;
+    notes_.push_back(os.str());
+  }
+  if (c.drilling > 0)
+    notes_.push_back("drilling friction NOT modelled: Simbody's Hertz contact has no torsional friction, so this run "
+                     "is of the scene without it (contact.drilling ignored)");
+  const BodyModel& m = body_;
+  if (m.stem && scene_.body.truncation_height > 0 && scene_.body.truncation_height / m.R < (m.R - m.r) / m.l)
+    notes_.push_back("ball modelled as a full sphere although its cut cap can reach the floor before the stem tip");
+}
+
+BodyState SimbodySimulator::read_state(const SimTK::State& s) const {
+  BodyState x;
+  x.t = s.getTime();
+  const SimTK::Transform& X = top_.getBodyTransform(s);
+  x.p_WG = to_eigen(X.p());
+  const SimTK::Quaternion q = X.R().convertRotationToQuaternion();
+  x.q_WB = Quat(q[0], q[1], q[2], q[3]).normalized();
+  // The body origin is G: the spatial velocity's linear part is v_G.
+  const SimTK::SpatialVec& V = top_.getBodyVelocity(s);
+  x.v_WG = to_eigen(V[1]);
+  x.w_B = x.q_WB.conjugate() * to_eigen(V[0]);
+  return x;
+}
+
+Contacts SimbodySimulator::read_contacts(const SimTK::State& s) const {
+  Contacts r;
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  const int n = contact_.getNumContactForces(s);
+  const SimTK::ContactSnapshot& active = tracker_.getActiveContacts(s);
+  for (int i = 0; i < n; ++i) {
+    const SimTK::ContactForce& f = contact_.getContactForce(s, i);
+    const SimTK::Contact& c = active.getContactById(f.getContactId());
+    // The force on the top: on surface 2 as reported, or its negative when the top is surface 1.
+    const bool top_second = c.getSurface2() == ball_surface_ || (stem_surface_.isValid() && c.getSurface2() == stem_surface_);
+    const SimTK::ContactSurfaceIndex mine = top_second ? c.getSurface2() : c.getSurface1();
+    const double f_n = (top_second ? 1.0 : -1.0) * f.getForceOnSurface2()[1][2];
+    const bool on_stem = stem_surface_.isValid() && mine == stem_surface_;
+    (on_stem ? r.stem : r.ball) = true;
+    r.normal_force += f_n;
+    (on_stem ? r.normal_force_stem : r.normal_force_ball) += f_n;
+    moment += f_n * to_eigen(f.getContactPoint());
+  }
+  if (r.normal_force > 0) {
+    r.point_valid = true;
+    r.p_WC = moment / r.normal_force;
+  }
+  return r;
+}
+
+SimbodySimulator::StepProbe SimbodySimulator::probe(const BodyState& x) const {
+  StepProbe p;
+  p.state = x;
+  p.cos_theta = (x.q_WB * Eigen::Vector3d::UnitZ()).z();
+  p.gap_ball = surface_gap(body_, x, Surface::Ball);
+  p.gap_stem = body_.stem ? surface_gap(body_, x, Surface::Stem) : 1e300;
+  return p;
+}
+
+void SimbodySimulator::fail(RunStatus s, double t, const std::string& why) {
+  status_ = s;
+  status_time_ = t;
+  status_detail_ = why;
+  events_.push_back({to_string(s), t, why, 0.0});
+}
+
+void SimbodySimulator::advance_to(double t) {
+  while (status_ == RunStatus::Ok && integ_->getTime() < t) {
+    const double before = integ_->getTime();
+    try {
+      const auto why = integ_->stepTo(t);
+      if (why == SimTK::Integrator::EndOfSimulation) {
+        fail(RunStatus::Failed, integ_->getTime(), "Simbody ended the integration");
+        return;
+      }
+    } catch (const std::exception& e) {
+      // Simbody throws when it cannot reach its accuracy (step below its minimum, a
+      // realization that fails): a run that ends, not a crash.
+      fail(RunStatus::Failed, integ_->getTime(), std::string("Simbody: ") + e.what());
+      return;
+    }
+    if (integ_->getTime() > before) after_step();
+  }
+}
+
+// The checks of the shared fixed-step loop (engines/fixed_step.cpp), after each accepted step.
+void SimbodySimulator::after_step() {
+  ++work_.steps;
+  const SimTK::State& s = integ_->getState();
+  const double t = s.getTime();
+  report_ = read_contacts(s);
+  const StepProbe now = probe(read_state(s));
+  const BodyState& y = now.state;
+  if (!(y.p_WG.allFinite() && y.v_WG.allFinite() && y.q_WB.coeffs().allFinite() && y.w_B.allFinite()))
+    return fail(RunStatus::Diverged, t, "non-finite state");
+  track_events(last_, now);
+  last_ = now;
+  const double gap = std::min(now.gap_ball, now.gap_stem);
+  if (gap < -limits_.penetration_fraction * body_.R) {
+    std::ostringstream why;
+    why << "fell through the floor: lowest point at " << gap << " (limit " << -limits_.penetration_fraction * body_.R << ")";
+    return fail(RunStatus::Diverged, t, why.str());
+  }
+  const double e = energy(body_, y);
+  if (e0_ > 0 && e > limits_.energy_factor * e0_) {
+    std::ostringstream why;
+    why << "energy " << e << " above " << limits_.energy_factor << " E0 = " << limits_.energy_factor * e0_;
+    return fail(RunStatus::Diverged, t, why.str());
+  }
+  const double speed = std::max(y.w_B.norm(), y.v_WG.norm() / body_.R);
+  if (speed > limits_.speed_factor * speed_scale_) {
+    std::ostringstream why;
+    why << "speed blow-up: " << speed << " rad/s equivalent";
+    return fail(RunStatus::Diverged, t, why.str());
+  }
+}
+
+void SimbodySimulator::track_events(const StepProbe& a, const StepProbe& b) {
+  const double ta = a.state.t, tb = b.state.t;
+  // Located by linear interpolation of the event function across the step, as for the
+  // fixed-step engines (Simbody's steps are its own, so the interval is the accepted step).
+  auto cross = [&](double fa, double fb) { return ta + (tb - ta) * fa / (fa - fb); };
+  if (!inverted_ && a.cos_theta > 0 && b.cos_theta <= 0) {
+    inverted_ = true;
+    events_.push_back({"inversion", cross(a.cos_theta, b.cos_theta), "theta crosses 90 deg", 0.0});
+  }
+  const Contacts& c = report_;
+  if (body_.stem && !stem_touched_ && c.stem) {
+    stem_touched_ = true;
+    const double te = (a.gap_stem > 0 && b.gap_stem <= 0) ? cross(a.gap_stem, b.gap_stem) : tb;
+    events_.push_back({"stem_contact", te, "first stem contact reported by the engine", 0.0});
+  }
+  Surface s = Surface::None;
+  if (c.ball && c.stem) s = Surface::Both;
+  else if (c.ball) s = Surface::Ball;
+  else if (c.stem) s = Surface::Stem;
+  if (s != contact_surface_) {
+    events_.push_back({"switch", tb, std::string(to_string(contact_surface_)) + " -> " + to_string(s), 0.0});
+    contact_surface_ = s;
+  }
+}
+
+Observation SimbodySimulator::observe() const {
+  const BodyState x = state();
+  Observation o = report_.ball && report_.stem ? observe_kinematics_on_both(body_, x) : observe_kinematics(body_, x);
+  o.normal_force = report_.normal_force;
+  o.engine_contact_valid = report_.point_valid;
+  o.p_WC_engine = report_.p_WC;
+  return o;
+}
+
+void SimbodySimulator::set_state(const BodyState& x) {
+  if (!(x.p_WG.allFinite() && x.v_WG.allFinite() && x.q_WB.coeffs().allFinite() && x.w_B.allFinite()) ||
+      x.q_WB.norm() < 1e-12)
+    throw std::invalid_argument("simbody: set_state: non-finite state or zero quaternion");
+  using namespace SimTK;
+  const Quat q = x.q_WB.normalized();
+  State s = integ_->getState();
+  top_.setQToFitTransform(s, Transform(Rotation(Quaternion(q.w(), q.x(), q.y(), q.z())), to_simtk(x.p_WG)));
+  top_.setUToFitVelocity(s, SpatialVec(to_simtk(q * x.w_B), to_simtk(x.v_WG)));
+  system_.realize(s, Stage::Velocity);
+  // A new initial value problem from here: the integrator restarts (its counters with it, so
+  // they are carried over).
+  realizations_before_ += integ_->getNumRealizations();
+  iterations_before_ += integ_->getNumIterations();
+  integ_->initialize(s);
+  report_ = read_contacts(integ_->getState());
+  last_ = probe(read_state(integ_->getState()));
+}
+
+WorkCounters SimbodySimulator::work() const {
+  WorkCounters w = work_;
+  w.rhs_evaluations = realizations_before_ + integ_->getNumRealizations();
+  w.solver_iterations = iterations_before_ + integ_->getNumIterations();
+  return w;
+}
+
+MassReadback SimbodySimulator::mass_properties() const {
+  const SimTK::MassProperties& mp = top_.getBodyMassProperties(integ_->getState());
+  MassReadback r;
+  r.mass = mp.getMass();
+  r.p_GCm_B = to_eigen(mp.getMassCenter());
+  // Simbody's inertia is about the body origin, G.
+  const SimTK::Mat33 I = mp.calcInertia().toMat33();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.I_G_B(i, j) = I(i, j);
+  return r;
+}
+
+void check_combination(const SimbodySettings& s, const Scene& scene) {
+  const SimbodyFriction f = simbody_friction(s, scene.contact);
+  if (f.us < f.ud)
+    throw std::invalid_argument("engines.simbody.static_friction: " + round_trip_text(f.us) +
+                                " below the dynamic friction " + round_trip_text(f.ud) + " (Simbody needs static >= dynamic)");
+}
+
+}  // namespace
+
+std::unique_ptr<Simulator> make_simbody_simulator(const Scene& scene) {
+  check_combination(read_settings<SimbodySettings>("simbody", scene), scene);
+  return std::make_unique<SimbodySimulator>(scene);
+}
+
+const EngineInfo& simbody_engine_info() {
+  static const EngineInfo info = [] {
+    EngineInfo e;
+    e.name = "simbody";
+    e.role = EngineRole::Engine;
+    e.make = make_simbody_simulator;
+    set_settings_struct<SimbodySettings>(e, [](const SimbodySettings& s, const Scene& scene) { check_combination(s, scene); });
+    e.version = simbody_version();
+    e.colour = "#56B4E9";  // Okabe-Ito sky blue
+    return e;
+  }();
+  return info;
+}
+
+}  // namespace tippe
