@@ -13,6 +13,7 @@
 
 #include "detail/reference_impl.h"
 #include "initial_state.h"
+#include "stop_request.h"
 
 namespace tippe {
 
@@ -354,6 +355,8 @@ void ReferenceModel::advance_to(double t) {
     }
     if (m.stepper.current_time() >= t) break;
     const double t_before = m.stepper.current_time();
+    // A signal ends the run within kStepsPerStopPoll steps, however long the way to t.
+    if ((steps_ - steps_start) % kStepsPerStopPoll == 0) poll_stop();
     m.step();
     const StateVector& y = m.stepper.current_state();
     for (double v : y)

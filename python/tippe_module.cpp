@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -17,7 +18,16 @@ namespace {
 // reader with the same checks and messages (the label "dict" stands for the file).
 toml::array to_toml_array(const py::handle& list, const std::string& key);
 
-void insert_value(toml::table& t, const std::string& key, const py::handle& v, const std::string& where) {
+// The deepest dict a scene may be: a scene file's keys nest 3 deep, and the reader refuses keys of
+// more than 64 parts (kMaxTomlKeyParts); deeper would recurse here without bound.
+constexpr int kMaxDictDepth = 64;
+
+// The dicts on the way from the root to the one being converted (by identity): a dict that
+// contains itself is refused instead of recursing until the interpreter crashes.
+using DictPath = std::set<const PyObject*>;
+
+void insert_value(toml::table& t, const std::string& key, const py::handle& v, const std::string& where,
+                  DictPath& open, int depth) {
   const std::string path = where.empty() ? key : where + "." + key;
   if (py::isinstance<py::bool_>(v)) {
     t.insert_or_assign(key, v.cast<bool>());
@@ -28,11 +38,16 @@ void insert_value(toml::table& t, const std::string& key, const py::handle& v, c
   } else if (py::isinstance<py::str>(v)) {
     t.insert_or_assign(key, v.cast<std::string>());
   } else if (py::isinstance<py::dict>(v)) {
+    if (open.count(v.ptr())) throw py::value_error(path + ": the dict contains itself (a cycle)");
+    if (depth >= kMaxDictDepth)
+      throw py::value_error(path.substr(0, 80) + "...: dicts nested deeper than " + std::to_string(kMaxDictDepth));
+    open.insert(v.ptr());
     toml::table sub;
     for (const auto& kv : v.cast<py::dict>()) {
       if (!py::isinstance<py::str>(kv.first)) throw py::type_error(path + ": keys must be strings");
-      insert_value(sub, kv.first.cast<std::string>(), kv.second, path);
+      insert_value(sub, kv.first.cast<std::string>(), kv.second, path, open, depth + 1);
     }
+    open.erase(v.ptr());
     t.insert_or_assign(key, std::move(sub));
   } else if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
     t.insert_or_assign(key, to_toml_array(v, path));
@@ -55,9 +70,10 @@ toml::array to_toml_array(const py::handle& list, const std::string& key) {
 
 std::string scene_dict_to_toml(const py::dict& d) {
   toml::table root;
+  DictPath open = {d.ptr()};
   for (const auto& kv : d) {
     if (!py::isinstance<py::str>(kv.first)) throw py::type_error("scene keys must be strings");
-    insert_value(root, kv.first.cast<std::string>(), kv.second, "");
+    insert_value(root, kv.first.cast<std::string>(), kv.second, "", open, 1);
   }
   std::ostringstream os;
   os << root;

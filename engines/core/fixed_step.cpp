@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "../../analytic/stop_request.h"
+#include "settings.h"
 
 namespace tippe {
 
@@ -26,6 +28,9 @@ FixedStepSimulator::FixedStepSimulator(const Scene& scene, const EngineInfo& inf
     : info_(info), scene_(scene), body_(BodyModel::from_scene(scene)) {}
 
 void FixedStepSimulator::start(double dt) {
+  // A step that is not a positive number would run no step and call it a run (NaN), or never end.
+  if (!(dt > 0) || !std::isfinite(dt))
+    throw std::invalid_argument("timestep " + round_trip_text(dt) + ": must be a positive finite number");
   dt_ = dt;
   const BodyState x0 = engine_state();
   last_.state = x0;
@@ -117,8 +122,8 @@ void FixedStepSimulator::fail(RunStatus s, double t, const std::string& why) {
 }
 
 void FixedStepSimulator::advance_to(double t) {
-  // Steps whose end lies within half a step of t count as reaching t.
-  while (status_ == RunStatus::Ok && (static_cast<double>(n_steps_) + 0.5) * dt_ <= t) step_once();
+#include "../../analytic/stop_request.h"
+#include "settings.h"
 }
 
 void FixedStepSimulator::step_once() {

@@ -29,6 +29,11 @@ struct FailureLimits {
   double speed_factor = 100.0;     // |w| or |v_G| beyond factor * initial scale -> diverged
 };
 
+// The most steps one engine run takes: 1e9 steps are hours of any engine's time (a step costs
+// microseconds), far beyond a run the bench reports on; a timestep far below the run's scale
+// (1e-8 over a long run, a user's model) ends the run as failed with this said, never hangs.
+inline constexpr long long kMaxEngineSteps = 1000000000LL;
+
 // The template of an engine adapter: the stepping loop and every check, the identity (name and
 // version from the engine's EngineInfo) and what an adapter's engine_step leaves behind
 // (contacts, limit hit, solver iterations, notes) are here; an adapter builds its world and

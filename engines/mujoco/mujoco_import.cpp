@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "mujoco_import_analyser.h"
+#include "mujoco_settings.h"
+#include "settings.h"
 
 namespace tippe {
 
@@ -142,9 +144,36 @@ void Analyser::check_model() {
   if (m_->opt.density > 0 || m_->opt.viscosity > 0)
     fail("option density " + g(m_->opt.density) + ", viscosity " + g(m_->opt.viscosity) +
          ": the reference has no fluid forces");
+  check_options();
   const mjtNum* gr = m_->opt.gravity;
-  if (!(gr[0] == 0 && gr[1] == 0 && gr[2] < 0))
+  if (!(std::isfinite(gr[2]) && gr[0] == 0 && gr[1] == 0 && gr[2] < 0))
     fail("gravity " + g(gr[0]) + " " + g(gr[1]) + " " + g(gr[2]) + " does not point along -z (the floor's normal is +z)");
+}
+
+// The model's own options pass the bounds of the [engines.mujoco] keys that stand for them, one
+// range check whichever source a setting comes from: a timestep of 0 or 1e-300 never ends, nan
+// runs no step and a negative one runs backwards.
+void Analyser::check_options() const {
+  const mjOption& o = m_->opt;
+  const std::map<std::string, SettingValue> options = {
+      {"timestep", static_cast<double>(o.timestep)},
+      {"impratio", static_cast<double>(o.impratio)},
+      {"iterations", static_cast<long long>(o.iterations)},
+      {"tolerance", static_cast<double>(o.tolerance)},
+      {"noslip_iterations", static_cast<long long>(o.noslip_iterations)},
+      {"noslip_tolerance", static_cast<double>(o.noslip_tolerance)}};
+  MujocoSettings bounds;
+  SettingsReader reader("mujoco", options);
+  try {
+    bounds.visit(reader);
+  } catch (const std::invalid_argument& e) {
+    // "engines.mujoco.KEY: why" -> "FILE: <option KEY>: why (the bounds of engines.mujoco.KEY)"
+    const std::string text = e.what();
+    const size_t colon = text.find(": ");
+    const std::string key = text.substr(0, colon), why = colon == std::string::npos ? text : text.substr(colon + 2);
+    const std::string attribute = key.substr(key.rfind('.') + 1);
+    throw MjcfImportError(label_ + ": <option " + attribute + ">: " + why + " (the bounds of " + key + ")");
+  }
 }
 
 void Analyser::find_geoms(MjcfTopImport& out) {

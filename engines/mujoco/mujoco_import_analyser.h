@@ -25,6 +25,7 @@ class Analyser {
   Analyser(const mjModel* m, std::string label) : m_(m), label_(std::move(label)) {}
 
   [[noreturn]] void fail(const std::string& why) const;
+  void check_options() const;
 
   MjcfTopImport run(const std::string& body_name, const std::string& key_name, MjTopIds* ids);
 

@@ -209,6 +209,15 @@ void Analyser::start(MjcfTopImport& out, const std::string& key_name) {
   out.keyframe = k >= 0 ? (mj_id2name(m_, mjOBJ_KEY, k) ? mj_id2name(m_, mjOBJ_KEY, k) : "") : "";
   const int qadr = m_->jnt_qposadr[joint_], vadr = m_->jnt_dofadr[joint_];
   const mjtNum* qpos = (k >= 0 ? m_->key_qpos + k * m_->nq : m_->qpos0) + qadr;
+  // A start that is not a number is refused here, naming the keyframe, not later in the scene.
+  const std::string where = k >= 0 ? "keyframe '" + out.keyframe + "'" : "the body's pos/quat (qpos0)";
+  for (int i = 0; i < 7; ++i)
+    if (!std::isfinite(qpos[i])) fail(where + ": qpos[" + std::to_string(qadr + i) + "] = " + g(qpos[i]) + " is not a finite number");
+  if (k >= 0)
+    for (int i = 0; i < 6; ++i)
+      if (!std::isfinite(m_->key_qvel[k * m_->nv + vadr + i]))
+        fail(where + ": qvel[" + std::to_string(vadr + i) + "] = " + g(m_->key_qvel[k * m_->nv + vadr + i]) +
+             " is not a finite number");
   const Vec3 p_WF = v3(qpos);
   // MuJoCo normalises the free joint's quaternion before use (mj_kinematics).
   const Quat q_WF = q4(qpos + 3).normalized();

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "../../analytic/initial_state.h"
+#include "../../analytic/stop_request.h"
 #include "fixed_step.h"  // FailureLimits: the same divergence limits as every engine
 #include "registry.h"
 #include "settings.h"
@@ -336,6 +337,8 @@ void SimbodySimulator::fail(RunStatus s, double t, const std::string& why) {
 
 void SimbodySimulator::advance_to(double t) {
   while (status_ == RunStatus::Ok && integ_->getTime() < t) {
+    // A signal ends the run within one of its steps (one relaxed atomic load each).
+    poll_stop();
     const double before = integ_->getTime();
     try {
       const auto why = integ_->stepTo(t);

@@ -39,6 +39,10 @@ using Setup = Command (*)(CLI::App& app);
 // tell "the settings fail" from "tippe broke".
 inline constexpr int kInternalExit = 3;
 
+// The most parallel runs --jobs takes: far above any machine's cores, and a range a user can read
+// in the message (CLI::PositiveNumber answered --jobs 0 with a 309-digit bound).
+inline constexpr int kMaxJobs = 4096;
+
 inline int error_exit(const std::exception_ptr& e, bool print = true) {
   try {
     std::rethrow_exception(e);

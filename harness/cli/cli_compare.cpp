@@ -56,7 +56,9 @@ int compare(const CompareCliOptions& o) {
   }
   // The comparison's files are one unit, written beside DIR and swapped in whole.
   const InterruptGuard interrupts;
-  OutputDir out(dir);
+  std::vector<fs::path> inputs = scene_input_files(scene);
+  if (!opts.cache_dir.empty()) inputs.emplace_back(opts.cache_dir);  // the cache outlives the output
+  OutputDir out(dir, OutputKind::Comparison, inputs);
   opts.out_dir = out.stage(false).string();
   const Comparison c = run_comparison(scene, opts);
   write_report(opts.out_dir, to_json(c), !o.no_plots);
@@ -104,7 +106,7 @@ int report(const std::string& dir, bool no_plots, bool summary_line) {
   }
   // The rebuilt report replaces the old one as a unit; the records stay as they are.
   const InterruptGuard interrupts;
-  OutputDir out(dir);
+  OutputDir out(dir, OutputKind::Comparison);
   write_report(out.stage(true).string(), j, !no_plots);
   out.commit();
   print_table_and_findings(j);
@@ -126,7 +128,7 @@ Command setup_compare(CLI::App& app) {
       ->check(CLI::IsMember(available_engines()))
       ->capture_default_str();
   sub->add_option("--out", o->out, "Output directory (default out/<scene name>-compare)");
-  sub->add_option("--jobs,-j", o->jobs, "Runs in parallel (default: one per core)")->check(CLI::PositiveNumber);
+  sub->add_option("--jobs,-j", o->jobs, "Runs in parallel (default: one per core)")->check(CLI::Range(1, kMaxJobs));
   sub->add_option("--cache", o->cache, "Reference cache directory")->capture_default_str();
   sub->add_flag("--no-cache", o->no_cache, "Always run the reference; leave the cache alone");
   sub->add_flag("--no-plots", o->no_plots, "Skip the gnuplot SVGs");

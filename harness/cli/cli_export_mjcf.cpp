@@ -21,6 +21,8 @@ struct ExportOptions {
 
 int export_mjcf(const ExportOptions& o) {
   const Scene scene = load_scene(o.scene, o.sets);
+  // The model written over the scene (or over the scene's own model) would replace it.
+  if (!o.out.empty()) refuse_output_over_inputs(o.out, scene_input_files(scene));
   std::string text;
   try {
     text = mujoco_mjcf(scene);

@@ -56,6 +56,13 @@ int gate(const GateCliOptions& o) {
   const std::vector<BoundaryCheck> boundaries = load_boundary_checks(o.gates, check_names);
   check_output(o.junit, "--junit");
   check_output(o.json, "--json");
+  // A report written over the gate file, a scene, a model or a sweep file would destroy it.
+  std::vector<fs::path> inputs = {o.gates};
+  for (const Check& c : g.checks)
+    for (const fs::path& f : scene_input_files(c.loaded)) inputs.push_back(f);
+  for (const BoundaryCheck& b : boundaries) inputs.emplace_back(b.sweep_path);
+  if (!o.junit.empty() && o.junit != "-") refuse_output_over_inputs(o.junit, inputs, "--junit");
+  if (!o.json.empty() && o.json != "-") refuse_output_over_inputs(o.json, inputs, "--json");
   std::error_code ec;
   if (o.junit == "-" && o.json == "-") throw UsageError("--junit and --json both name stdout (-)");
   if (!o.junit.empty() && !o.json.empty() && o.junit != "-" && o.json != "-" &&
@@ -165,7 +172,7 @@ Command setup_gate(CLI::App& app) {
   sub->add_option("--junit", o->junit, "Write a JUnit XML report to FILE (- for stdout)");
   sub->add_option("--json", o->json, "Write the results as JSON to FILE (- for stdout)");
   sub->add_option("--jobs,-j", o->jobs, "Runs in parallel within a comparison (default: one per core)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, kMaxJobs));
   sub->add_option("--cache", o->cache, "Reference cache directory")->capture_default_str();
   sub->add_option("--boundary-out", o->boundary_out, "Directory of the sweeps that [[boundary]] checks run")
       ->capture_default_str();

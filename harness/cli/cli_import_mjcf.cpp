@@ -126,7 +126,9 @@ int import_mjcf(const ImportOptions& o) {
   if (!is_valid_utf8(o.model) || !is_valid_utf8(o.out))
     throw UsageError("import-mjcf: the paths must be valid UTF-8 (the scene and its records are text)");
   if (!(o.duration > 0 && std::isfinite(o.duration))) throw UsageError("--duration: must be a positive number");
-  if (const std::string why = result_file_problem(o.out); !why.empty()) throw UsageError(why);
+  if (const std::string why = result_file_problem(o.out); !why.empty()) throw UsageError(o.out + ": " + why);
+  // The scene written over the model would replace it (and name itself as its model).
+  refuse_output_over_inputs(o.out, {o.model});
   MjcfTopImport top;
   try {
     top = import_mjcf_top(o.model, o.body, o.keyframe);
@@ -148,7 +150,8 @@ int import_mjcf(const ImportOptions& o) {
   try {
     (void)parse_scene_text(text, o.out);
   } catch (const SceneError& e) {
-    throw UsageError(o.model + ": body '" + top.body + "': the imported scene is not one the bench can run: " + e.what());
+    throw UsageError(o.model + ": body '" + top.body + "': the imported scene is not one the bench can run (" + o.out +
+                     " not written): " + e.what());
   }
   write_result_file(o.out, text);
 

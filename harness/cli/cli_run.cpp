@@ -120,7 +120,7 @@ int run(const RunOptions& o) {
   // The run's files are one unit: written beside DIR and swapped in whole, so that an
   // interrupted rerun (a signal, a full disk) leaves the earlier run's files as they were.
   const InterruptGuard interrupts;
-  OutputDir out(dir);
+  OutputDir out(dir, OutputKind::Run, scene_input_files(scene));
   const fs::path stage = out.stage(false);
   CsvTrajectoryWriter csv((stage / "trajectory.csv").string());
   ProgressLine progress(o.engine);

@@ -39,7 +39,7 @@ int report_only(const SweepCliOptions& o) {
   if (!fs::is_regular_file(records, ec)) throw UsageError(records.string() + ": cannot read (not a sweep directory?)");
   // Locked like every output directory: a report is not rebuilt under a sweep still running.
   const InterruptGuard interrupts;
-  OutputDir dir(o.report_dir);
+  OutputDir dir(o.report_dir, OutputKind::Sweep);
   RecordsFile f;
   try {
     f = read_records(records.string());
@@ -212,7 +212,7 @@ Command setup_sweep(CLI::App& app) {
       "one, ladder.search); records.jsonl and a report");
   sub->add_option("sweep", o->sweep, "Sweep file (TOML), e.g. harness/sweeps/default.toml");
   sub->add_option("--out", o->out, "Output directory (default out/<sweep name>-sweep); rerun to resume");
-  sub->add_option("--jobs,-j", o->jobs, "Runs in parallel (default: one per core)")->check(CLI::PositiveNumber);
+  sub->add_option("--jobs,-j", o->jobs, "Runs in parallel (default: one per core)")->check(CLI::Range(1, kMaxJobs));
   sub->add_flag("--restart", o->restart,
                 "Begin the output directory again (needed when the sweep file or a scene's physics changed); "
                 "earlier records are kept as records.jsonl.old (.old.2, ... when that exists)");

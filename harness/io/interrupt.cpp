@@ -11,8 +11,6 @@ namespace tippe {
 namespace {
 
 std::atomic<int> g_guards{0};
-std::atomic<int> g_signal{0};
-static_assert(std::atomic<int>::is_always_lock_free, "the handler may only touch lock-free atomics");
 
 extern "C" void on_signal(int sig) {
   if (g_guards.load() == 0) {
@@ -22,14 +20,10 @@ extern "C" void on_signal(int sig) {
     return;
   }
   int none = 0;
-  g_signal.compare_exchange_strong(none, sig);
+  g_stop_request.compare_exchange_strong(none, sig);
 }
 
 }  // namespace
-
-Interrupted::Interrupted(int signal)
-    : signal_(signal), what_(std::string("interrupted by ") + (sigabbrev_np(signal) ? "SIG" : "signal ") +
-                             (sigabbrev_np(signal) ? sigabbrev_np(signal) : std::to_string(signal).c_str())) {}
 
 void install_interrupt_handlers() {
   struct sigaction sa {};
@@ -43,8 +37,6 @@ InterruptGuard::InterruptGuard() { g_guards.fetch_add(1); }
 
 InterruptGuard::~InterruptGuard() { g_guards.fetch_sub(1); }
 
-void check_interrupted() {
-  if (const int sig = g_signal.load(std::memory_order_relaxed)) throw Interrupted(sig);
-}
+void check_interrupted() { poll_stop(); }
 
 }  // namespace tippe

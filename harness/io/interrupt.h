@@ -1,23 +1,9 @@
 // SIGINT, SIGTERM and SIGHUP end a command cleanly: work that leaves files behind stops at its next check and cleans up.
 #pragma once
 
-#include <exception>
-#include <string>
+#include "stop_request.h"  // Interrupted, and the request the stepping loops poll
 
 namespace tippe {
-
-// Thrown by check_interrupted(): unwinding removes staging directories and temporary files;
-// main exits with 128 + the signal's number.
-class Interrupted : public std::exception {
- public:
-  explicit Interrupted(int signal);
-  const char* what() const noexcept override { return what_.c_str(); }
-  int signal() const { return signal_; }
-
- private:
-  int signal_;
-  std::string what_;
-};
 
 // Installs the handlers (main, once). While no InterruptGuard lives, a signal has its default
 // effect at once (a sweep's points are fsynced records and resume after any kill); while one

@@ -7,8 +7,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
+
+#include <nlohmann/json.hpp>
 
 #include "io/interrupt.h"
 
@@ -49,7 +52,9 @@ std::string staging_prefix(const fs::path& dir) { return "." + dir.filename().st
 // Hard links of every file under `from` in `to` (directories made anew).
 void link_tree(const fs::path& from, const fs::path& to) {
   for (const auto& e : fs::recursive_directory_iterator(from)) {
-    const fs::path rel = fs::relative(e.path(), from), target = to / rel;
+    // Lexically: fs::relative resolves a symbolic link to its target, which would re-create the
+    // link outside `to` (where its target lies); a link is copied as the link it is, in place.
+    const fs::path rel = e.path().lexically_relative(from), target = to / rel;
     if (e.is_directory() && !e.is_symlink())
       fs::create_directory(target);
     else if (e.is_symlink())
@@ -59,9 +64,167 @@ void link_tree(const fs::path& from, const fs::path& to) {
   }
 }
 
+// A name against a pattern with at most one '*' (any characters).
+bool matches(const std::string& name, const std::string& pattern) {
+  const size_t star = pattern.find('*');
+  if (star == std::string::npos) return name == pattern;
+  const std::string head = pattern.substr(0, star), tail = pattern.substr(star + 1);
+  return name.size() >= head.size() + tail.size() && name.compare(0, head.size(), head) == 0 &&
+         name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+bool matches_any(const std::string& name, const std::vector<std::string>& patterns) {
+  return std::any_of(patterns.begin(), patterns.end(), [&](const std::string& p) { return matches(name, p); });
+}
+
+// What each kind writes into DIR itself, outside a staged unit (a sweep's records grow in place).
+const std::vector<std::string>& direct_names(OutputKind kind) {
+  static const std::vector<std::string> none, sweep = {"sweep.json", "records.jsonl", "records.jsonl.old*", "reference"};
+  return kind == OutputKind::Sweep ? sweep : none;
+}
+
+// A directory written before the marker: its kind's record, and the names that kind writes.
+const char* legacy_record(OutputKind kind) {
+  switch (kind) {
+    case OutputKind::Run: return "summary.json";
+    case OutputKind::Comparison: return "comparison.json";
+    case OutputKind::Sweep: return "sweep.json";
+  }
+  return "";
+}
+
+const std::vector<std::string>& legacy_names(OutputKind kind) {
+  static const std::vector<std::string> run = {"summary.json", "trajectory.csv"};
+  static const std::vector<std::string> comparison = {"comparison.json", "report.md", "index.html", "plots.gp",
+                                                      "plots.log", "*.csv", "*.svg", "plot-*.dat"};
+  static const std::vector<std::string> sweep = {"sweep.json", "records.jsonl", "records.jsonl.old*", "reference",
+                                                 "report.md", "index.html", "sweep-plots.gp", "plots.log",
+                                                 "*.svg", "sweep-*.dat"};
+  return kind == OutputKind::Run ? run : kind == OutputKind::Comparison ? comparison : sweep;
+}
+
+// The marker's kind and files; nullopt-like (ok false) when it is missing or not a marker.
+struct Marker {
+  bool ok = false;
+  std::string kind;
+  std::vector<std::string> files;
+};
+
+Marker read_marker(const fs::path& dir) {
+  Marker m;
+  std::error_code ec;
+  const fs::path file = dir / kOutputMarker;
+  if (!fs::is_regular_file(fs::symlink_status(file, ec))) return m;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(read_file_text(file.string(), kMaxInputFileBytes));
+    if (!j.is_object() || !j.contains("tippe_output") || !j.at("tippe_output").is_string() || !j.contains("files") ||
+        !j.at("files").is_array())
+      return m;
+    for (const auto& f : j.at("files")) {
+      if (!f.is_string()) return m;
+      m.files.push_back(f.get<std::string>());
+    }
+    m.kind = j.at("tippe_output").get<std::string>();
+    m.ok = true;
+  } catch (const std::exception&) {
+    m.ok = false;
+  }
+  return m;
+}
+
+void write_marker(const fs::path& dir, OutputKind kind) {
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name != kOutputMarker) files.push_back(name);
+  }
+  std::sort(files.begin(), files.end());
+  const nlohmann::json j = {{"tippe_output", to_string(kind)}, {"files", files}};
+  write_file_atomic((dir / kOutputMarker).string(), j.dump(1) + "\n");
+}
+
+// Whether `inner` is `outer` or lies inside it (both absolute and normal).
+bool within(const fs::path& inner, const fs::path& outer) {
+  auto i = inner.begin();
+  for (auto o = outer.begin(); o != outer.end(); ++o, ++i) {
+    if (o->empty()) continue;  // a trailing separator
+    if (i == inner.end() || *i != *o) return false;
+  }
+  return true;
+}
+
+fs::path real(const fs::path& p) {
+  std::error_code ec;
+  fs::path r = fs::weakly_canonical(fs::absolute(p, ec), ec);
+  if (ec) r = fs::absolute(p, ec).lexically_normal();
+  if (!r.has_filename() && r != r.root_path()) r = r.parent_path();
+  return r;
+}
+
 }  // namespace
 
-OutputDir::OutputDir(const fs::path& dir) {
+const char* to_string(OutputKind kind) {
+  switch (kind) {
+    case OutputKind::Run: return "run";
+    case OutputKind::Comparison: return "comparison";
+    case OutputKind::Sweep: return "sweep";
+  }
+  return "?";
+}
+
+void refuse_output_over_inputs(const fs::path& out, const std::vector<fs::path>& inputs, const std::string& option) {
+  const fs::path o = real(out);
+  std::error_code ec;
+  for (const fs::path& in : inputs) {
+    if (in.empty()) continue;
+    const fs::path i = real(in);
+    // The same file by another name (a hard link) is the input too.
+    if (i == o || (fs::exists(in, ec) && fs::exists(out, ec) && fs::equivalent(in, out, ec)))
+      throw OutputError(option + " " + out.string() + ": is the input " + in.string() +
+                        "; writing there would destroy it: give another " + option);
+    if (within(i, o))
+      throw OutputError(option + " " + out.string() + ": contains the input " + in.string() +
+                        "; the output replaces what it holds: give another " + option);
+  }
+}
+
+void OutputDir::check_contents(const fs::path& given) {
+  std::error_code ec;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir_, ec)) names.push_back(e.path().filename().string());
+  if (ec) throw OutputError(given.string() + ": cannot list the output directory: " + ec.message());
+  std::sort(names.begin(), names.end());
+  const bool has_marker = std::find(names.begin(), names.end(), kOutputMarker) != names.end();
+  const Marker m = has_marker ? read_marker(dir_) : Marker{};
+  if (m.ok && m.kind != to_string(kind_))
+    throw OutputError(given.string() + ": is a " + m.kind + "'s output directory (its " + kOutputMarker +
+                      " says so); a " + to_string(kind_) + " never replaces it: give another --out");
+  auto holds = [&](const char* name) { return std::find(names.begin(), names.end(), name) != names.end(); };
+  const bool legacy = !has_marker && holds(legacy_record(kind_));
+  if (!has_marker && !legacy)
+    for (OutputKind other : {OutputKind::Sweep, OutputKind::Comparison, OutputKind::Run})
+      if (other != kind_ && holds(legacy_record(other)))
+        throw OutputError(given.string() + ": is a " + to_string(other) + "'s output directory (it holds " +
+                          legacy_record(other) + "); a " + to_string(kind_) + " never replaces it: give another --out");
+  std::vector<std::string> foreign;
+  for (const std::string& n : names) {
+    if (n == kOutputMarker && m.ok) continue;
+    const bool own = m.ok ? (std::find(m.files.begin(), m.files.end(), n) != m.files.end() ||
+                             matches_any(n, direct_names(kind_)))
+                          : legacy && matches_any(n, legacy_names(kind_));
+    if (!own) foreign.push_back(n);
+  }
+  if (foreign.empty()) return;
+  std::string list;
+  const size_t shown = std::min<size_t>(foreign.size(), 10);
+  for (size_t i = 0; i < shown; ++i) list += (i ? ", " : "") + foreign[i];
+  if (foreign.size() > shown) list += " and " + std::to_string(foreign.size() - shown) + " more";
+  throw OutputError(given.string() + " holds files tippe did not write: " + list +
+                    "; use an empty or a tippe directory");
+}
+
+OutputDir::OutputDir(const fs::path& dir, OutputKind kind, const std::vector<fs::path>& inputs) : kind_(kind) {
+  refuse_output_over_inputs(dir, inputs);
   std::error_code ec;
   // Symbolic links are followed (DIR through a link writes the directory it names): the swap
   // renames the real directory, and the link keeps naming it.
@@ -81,6 +244,16 @@ OutputDir::OutputDir(const fs::path& dir) {
   dir_fd_ = open_locked(dir_);
   if (dir_fd_ == -1) throw OutputError(dir.string() + ": in use by another tippe command (locked)");
   if (dir_fd_ < 0) throw OutputError(dir.string() + ": cannot lock the output directory: " + why(errno));
+  // What DIR holds is checked under the lock, so that no other tippe changes it in between.
+  try {
+    check_contents(dir);
+    // A sweep writes its records into DIR itself: DIR says it is a sweep's from the start.
+    if (!direct_names(kind_).empty()) write_marker(dir_, kind_);
+  } catch (...) {
+    ::close(dir_fd_);
+    dir_fd_ = -1;
+    throw;
+  }
 
   // Staging directories of runs that died (killed, the machine lost) are free to lock: removed.
   const std::string prefix = staging_prefix(dir_);
@@ -97,7 +270,16 @@ OutputDir::OutputDir(const fs::path& dir) {
 OutputDir::~OutputDir() {
   remove_staging();
   std::error_code ec;
-  if (created_ && fs::is_empty(dir_, ec) && !ec) fs::remove(dir_, ec);
+  // A directory made for nothing (a marker alone at most) is removed again.
+  if (created_) {
+    bool only_marker = true;
+    for (const auto& e : fs::directory_iterator(dir_, ec))
+      only_marker = only_marker && e.path().filename() == kOutputMarker;
+    if (only_marker && !ec) {
+      fs::remove(dir_ / kOutputMarker, ec);
+      fs::remove(dir_, ec);
+    }
+  }
   if (dir_fd_ >= 0) ::close(dir_fd_);
 }
 
@@ -141,6 +323,8 @@ fs::path OutputDir::stage(bool keep_existing) {
 
 void OutputDir::commit() {
   if (staging_.empty()) throw std::logic_error("OutputDir::commit without stage");
+  // The unit says what it is and which files are tippe's.
+  write_marker(staging_, kind_);
   // A signal that came while the unit was written keeps the old set.
   check_interrupted();
   if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, dir_.c_str(), RENAME_EXCHANGE) != 0) {

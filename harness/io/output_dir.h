@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "io/files.h"
 
@@ -12,7 +13,25 @@ namespace tippe {
 // OutputError (records.h) for every path here that cannot be used: cannot be created, is not a
 // directory, is held by another tippe, cannot be staged beside.
 
+// The kinds of output directory: a directory of one kind is never written by a command of
+// another (a run never replaces a sweep's records).
+enum class OutputKind { Run, Comparison, Sweep };
+const char* to_string(OutputKind kind);
+
+// The file in every output directory that says tippe wrote it: JSON {"tippe_output": KIND,
+// "files": [NAME, ...]}, the kind and the top-level names the last unit committed. Written into
+// each unit before its swap (and, for a sweep, whose records grow in DIR itself, when DIR is
+// opened). What tippe owns in DIR is what this file lists, plus the names a sweep writes straight
+// into DIR (sweep.json, records.jsonl, records.jsonl.old*, reference/). A directory written
+// before the marker existed is recognised by its record (summary.json, comparison.json,
+// sweep.json) and then owns the names its kind writes (summary.json and trajectory.csv;
+// comparison.json, report.md, index.html, *.csv, *.svg, plot-*.dat, plots.gp; a sweep's report).
+inline constexpr const char* kOutputMarker = ".tippe-output";
+
 // DIR for the life of a command:
+//  - refused when it is, or contains, one of `inputs` (a scene, a model, a sweep file, a shard:
+//    the swap would delete it), or when it holds a marker of another kind, or anything tippe did
+//    not write ("DIR holds files tippe did not write: a, b; use an empty or a tippe directory");
 //  - created (with its parents) when missing; an existing DIR must be a directory;
 //  - locked: flock on the directory itself, not on a file in it, so deleting or replacing a lock
 //    file cannot let a second writer in; a DIR replaced between open and lock is opened again;
@@ -25,7 +44,7 @@ namespace tippe {
 // directories that an earlier, killed run left beside DIR are removed when DIR is opened.
 class OutputDir {
  public:
-  explicit OutputDir(const std::filesystem::path& dir);
+  OutputDir(const std::filesystem::path& dir, OutputKind kind, const std::vector<std::filesystem::path>& inputs = {});
   ~OutputDir();
   OutputDir(const OutputDir&) = delete;
   OutputDir& operator=(const OutputDir&) = delete;
@@ -43,10 +62,17 @@ class OutputDir {
 
  private:
   void remove_staging();
+  void check_contents(const std::filesystem::path& given);
+  OutputKind kind_;
   std::filesystem::path dir_, staging_;
   int dir_fd_ = -1, staging_fd_ = -1;
   bool created_ = false;
 };
+
+// Throws OutputError when `out` (an output file or directory) is one of `inputs` or, for a
+// directory, contains one: "OPTION OUT: is the input FILE" / "contains the input FILE".
+void refuse_output_over_inputs(const std::filesystem::path& out, const std::vector<std::filesystem::path>& inputs,
+                               const std::string& option = "--out");
 
 // A result file named on the command line (--junit, --json): "" when `path` can be written, else
 // the reason. Checked before any work, so that a typo does not cost a whole run.

@@ -77,11 +77,21 @@ class Interpreter : public TomlReader {
     for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
     if (key.back() == '.' || parts.empty() ||
         !std::all_of(parts.begin(), parts.end(), is_bare_key))
-      fail("--set", "malformed key \"" + key + "\" in \"" + text + "\" (expected dotted bare keys, e.g. contact.mu)");
+      fail("--set", "malformed key \"" + key.substr(0, 80) + "\" (expected dotted bare keys, e.g. contact.mu)");
+    if (parts.size() > static_cast<size_t>(kMaxTomlKeyParts))
+      fail("--set", "the key " + key.substr(0, 40) + "... has " + std::to_string(parts.size()) + " parts, more than " +
+                        std::to_string(kMaxTomlKeyParts));
 
     const std::string value_text = trim(text.substr(eq + 1));
     toml::table parsed;
     bool is_toml = false;
+    // An inline table's dotted keys nest as deep as a file's: the same bound, before toml++.
+    try {
+      check_toml_key_depth(value_text, "--set");
+    } catch (const SceneError&) {
+      fail("--set", "the value of " + key + " nests dotted keys deeper than " + std::to_string(kMaxTomlKeyParts) +
+                        " parts");
+    }
     try {
       parsed = toml::parse("v = " + value_text);
       is_toml = parsed.size() == 1 && parsed.contains("v");
@@ -457,6 +467,18 @@ Scene parse_scene_text(const std::string& text, const std::string& file_label,
                                                      overrides)
                                       : fnv1a64_hex(text, overrides);
   return s;
+}
+
+std::vector<std::filesystem::path> scene_input_files(const Scene& scene) {
+  std::vector<std::filesystem::path> files;
+  if (!scene.source_file.empty()) files.emplace_back(scene.source_file);
+  const auto engine = scene.engines.find("mujoco");
+  if (engine != scene.engines.end()) {
+    const auto it = engine->second.find("model");
+    if (it != engine->second.end())
+      if (const auto* path = std::get_if<std::string>(&it->second)) files.emplace_back(*path);
+  }
+  return files;
 }
 
 }  // namespace tippe

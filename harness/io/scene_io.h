@@ -2,6 +2,7 @@
 #pragma once
 
 #include <stdexcept>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,10 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
 // input (the fuzz target tests/fuzz/fuzz_scene.cpp holds it to that).
 Scene parse_scene_text(const std::string& text, const std::string& file_label,
                        const std::vector<std::string>& overrides = {});
+
+// The files a scene was read from: its own, and engines.mujoco.model when given (an output must
+// never be written over, or around, one of them).
+std::vector<std::filesystem::path> scene_input_files(const Scene& scene);
 
 // Every field of a scene, its mass properties and engine tables, for run records.
 nlohmann::json scene_to_json(const Scene& scene);

@@ -41,7 +41,93 @@ std::string toml_value_text(const toml::node& n) {
   return out + " " + text;
 }
 
+namespace {
+
+bool bare_key_char(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+}
+
+}  // namespace
+
+void check_toml_key_depth(const std::string& text, const std::string& file) {
+  size_t line = 1, col = 1;           // of text[i]
+  size_t first_line = 1, first_col = 1;  // of the current key's first part
+  int parts = 0;
+  bool after_part = false, after_dot = false;
+  auto advance = [&](size_t& i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+    ++i;
+  };
+  auto reset = [&] {
+    parts = 0;
+    after_part = after_dot = false;
+  };
+  auto part = [&](size_t at_line, size_t at_col) {
+    if (after_dot) {
+      ++parts;
+    } else {
+      parts = 1;
+      first_line = at_line;
+      first_col = at_col;
+    }
+    after_part = true;
+    after_dot = false;
+    if (parts > kMaxTomlKeyParts)
+      throw SceneError(file + ":" + std::to_string(first_line) + ":" + std::to_string(first_col) +
+                       ": a dotted key or table header of more than " + std::to_string(kMaxTomlKeyParts) +
+                       " parts (nested too deep to be a key of this file)");
+  };
+  for (size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    const size_t at_line = line, at_col = col;
+    if (c == '#') {
+      while (i < text.size() && text[i] != '\n') advance(i);
+      reset();
+    } else if (c == '"' || c == '\'') {
+      const bool triple = text.compare(i, 3, std::string(3, c)) == 0;
+      for (int k = 0; k < (triple ? 3 : 1); ++k) advance(i);
+      while (i < text.size()) {
+        if (c == '"' && text[i] == '\\') {
+          advance(i);
+          if (i < text.size()) advance(i);
+          continue;
+        }
+        if (triple ? text.compare(i, 3, std::string(3, c)) == 0 : text[i] == c) {
+          for (int k = 0; k < (triple ? 3 : 1); ++k) advance(i);
+          break;
+        }
+        if (!triple && text[i] == '\n') break;  // unterminated: toml++ says so
+        advance(i);
+      }
+      part(at_line, at_col);
+    } else if (bare_key_char(c)) {
+      while (i < text.size() && bare_key_char(text[i])) advance(i);
+      part(at_line, at_col);
+    } else if (c == '.') {
+      const bool dotted = after_part;
+      advance(i);
+      if (dotted) {
+        after_part = false;
+        after_dot = true;
+      } else {
+        reset();
+      }
+    } else if (c == ' ' || c == '\t') {
+      advance(i);
+    } else {
+      advance(i);
+      reset();
+    }
+  }
+}
+
 toml::table parse_toml(const std::string& text, const std::string& file) {
+  check_toml_key_depth(text, file);
   try {
     return toml::parse(text, file);
   } catch (const toml::parse_error& e) {

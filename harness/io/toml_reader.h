@@ -16,7 +16,18 @@ const char* toml_type_name(toml::node_type t);
 // UTF-8 character so that a long or binary value cannot flood the message.
 std::string toml_value_text(const toml::node& n);
 
-// Parses `text` as TOML; a syntax error throws SceneError "FILE:LINE:COL: reason".
+// The most parts a dotted key or a table header may have. The deepest key of any file the bench
+// reads has 4 (setup[i].ladder.key's "engines.mujoco.solref"); toml++ recurses once per part,
+// and a 100 KB file with a 50000-part key overflowed the stack (SIGSEGV).
+inline constexpr int kMaxTomlKeyParts = 64;
+
+// Throws SceneError "FILE:LINE:COL: a dotted key or table header of more than 64 parts" for the
+// first key in `text` that has more parts than kMaxTomlKeyParts. A scan of the bytes (strings and
+// comments skipped), done before toml++ parses anything.
+void check_toml_key_depth(const std::string& text, const std::string& file);
+
+// Parses `text` as TOML (after check_toml_key_depth); a syntax error throws SceneError
+// "FILE:LINE:COL: reason".
 toml::table parse_toml(const std::string& text, const std::string& file);
 // Reads FILE (at most kMaxInputFileBytes) and parses it; an unreadable file throws SceneError
 // naming it and why.

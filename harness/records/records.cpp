@@ -173,6 +173,38 @@ long long json_integer(const json& j, const char* key) {
   return v.get<long long>();
 }
 
+const std::vector<std::string>& run_status_names() {
+  static const std::vector<std::string> names = {"ok", "contact_lost", "diverged", "unphysical", "clamped", "failed"};
+  return names;
+}
+
+const std::vector<std::string>& event_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n = {"drill_slip", "drill_stick", "flight",  "graze",      "hold",  "impact",
+                                  "inversion",  "lift",        "press",   "projection", "reversion", "slip",
+                                  "stem_contact", "stick",     "switch",  "touchdown",  "two_contact", "unresolved"};
+    n.insert(n.end(), run_status_names().begin(), run_status_names().end());
+    return n;
+  }();
+  return names;
+}
+
+namespace {
+
+// A string field of a record that must be one of `names`; the message names the field.
+std::string one_of(const json& j, const char* key, const std::string& where, const std::vector<std::string>& names) {
+  const std::string v = j.at(key).get<std::string>();
+  if (std::find(names.begin(), names.end(), v) != names.end()) return v;
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw json::other_error::create(
+      501, where + key + ": " + json(v.substr(0, 40)).dump(-1, ' ', false, json::error_handler_t::replace) +
+               " is not one of " + list,
+      &j);
+}
+
+}  // namespace
+
 RunRecord from_json(const json& j) {
   // Summaries written before records carried a format have none; any other format is refused.
   if (j.contains("format") && j.at("format") != kRunRecordFormat)
@@ -186,7 +218,7 @@ RunRecord from_json(const json& j) {
   r.scene_spec = j.value("scene_spec", json());
   r.engine = j.at("engine").get<std::string>();
   r.engine_version = j.at("engine_version").get<std::string>();
-  r.status = j.at("status").get<std::string>();
+  r.status = one_of(j, "status", "", run_status_names());
   r.status_time = get_number(j, "status_time");
   r.status_detail = j.at("status_detail").get<std::string>();
   r.inversion_time = get_optional(j, "inversion_time");
@@ -212,9 +244,13 @@ RunRecord from_json(const json& j) {
   r.work.wall_seconds = get_number(w, "wall_seconds");
   r.work.cpu_seconds = get_number(w, "cpu_seconds");
   for (const json& e : j.at("events"))
-    r.events.push_back({e.at("name").get<std::string>(), get_number(e, "time"), e.at("detail").get<std::string>(),
-                        get_number(e, "value")});
-  for (const auto& [k, v] : j.at("settings").items()) r.settings.emplace_back(k, v.get<std::string>());
+    r.events.push_back({one_of(e, "name", "events[].", event_names()), get_number(e, "time"),
+                        e.at("detail").get<std::string>(), get_number(e, "value")});
+  for (const auto& [k, v] : j.at("settings").items()) {
+    if (!v.is_string())
+      throw json::other_error::create(501, "settings." + k.substr(0, 40) + ": expected a string, got " + v.type_name(), &j);
+    r.settings.emplace_back(k, v.get<std::string>());
+  }
   r.notes = j.at("notes").get<std::vector<std::string>>();
   r.provenance = provenance_from_json(j.at("provenance"));
   return r;

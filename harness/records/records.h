@@ -18,6 +18,13 @@
 
 namespace tippe {
 
+// The values a record's enumerated fields may hold when read back (records are input): a run's
+// status (to_string(RunStatus)) and its events' names (what the reference and the fixed-step
+// loop emit, plus the statuses a failing run records as an event).
+const std::vector<std::string>& run_status_names();
+const std::vector<std::string>& event_names();
+
+
 struct Provenance {
   std::string git_commit, compiler, cxx_flags;  // from build_info()
   std::string date;                             // UTC, ISO 8601, when the run started

@@ -284,9 +284,9 @@ SweepRecord sweep_record_from_json(const json& j) {
   }
   r.repeats = R::integer(j, "", "repeats", 1, kMaxRepeats);
   r.duration = R::number(j, "", "duration", 0.0);
-  // Any status reads (a newer build's reads with the class "failed" when no class is written); the
-  // class, which names the report's CSS classes, must be a known one.
-  r.status = R::string(j, "", "status");
+  // Records are input: the status and the class (which names the report's CSS classes) must be
+  // known ones.
+  r.status = R::name(j, "", "status", {"ok", "contact_lost", "diverged", "unphysical", "clamped", "failed"});
   r.status_time = R::number(j, "", "status_time");
   r.status_detail = R::string(j, "", "status_detail");
   r.inversion_time = R::optional(j, "", "inversion_time");
@@ -318,6 +318,9 @@ SweepRecord sweep_record_from_json(const json& j) {
   r.git_commit = R::string(j, "", "git_commit");
   r.settings = R::at(j, "", "settings");
   if (!r.settings.is_object()) R::fail("settings", std::string("expected an object, got ") + r.settings.type_name());
+  // A setting's value is its text as the engine listed it.
+  for (const auto& [k, v] : r.settings.items())
+    if (!v.is_string()) R::fail("settings." + utf8_replaced(k.substr(0, 40)), std::string("expected a string, got ") + v.type_name());
   if (j.contains("class")) {
     const json& c = R::at(j, "", "class");
     r.run_class = R::name(c, "class", "name", {"ok", "diverged", "unphysical", "clamped", "failed", "contact_lost"});
@@ -329,7 +332,7 @@ SweepRecord sweep_record_from_json(const json& j) {
   if (j.contains("reference") && !j.at("reference").is_null()) {
     const json& x = j.at("reference");
     SweepRecord::ReferenceRun f;
-    f.status = R::string(x, "reference", "status");
+    f.status = R::name(x, "reference", "status", {"ok", "contact_lost", "diverged", "unphysical", "clamped", "failed"});
     f.method = R::string(x, "reference", "method");
     f.run_class = R::name(x, "reference", "class", {"ok", "diverged", "unphysical", "clamped", "failed", "contact_lost"});
     f.rtol = R::number(x, "reference", "rtol", 0.0);

@@ -185,7 +185,8 @@ MergeOutcome merge_sweeps(const std::vector<std::string>& shard_dirs, const std:
   }
   // The merged directory is written as one unit beside the old one and swapped in at the end.
   const InterruptGuard guard;
-  OutputDir lock(out);
+  std::vector<fs::path> inputs(shard_dirs.begin(), shard_dirs.end());
+  OutputDir lock(out, OutputKind::Sweep, inputs);
   const fs::path stage = lock.stage(true);
   const fs::path staged_meta = stage / meta_file.filename(), staged_records = stage / records_file.filename();
   if (restart) keep_aside(staged_records);

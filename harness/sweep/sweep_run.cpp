@@ -158,7 +158,11 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<O
                           "; give --restart to begin the directory again, or another --out");
   }
 
-  lock = std::make_unique<OutputDir>(out);
+  // The sweep file and every scene (and model) it reads stay outside OUT.
+  std::vector<fs::path> inputs = {plan.spec.file};
+  for (const Scene& s : plan.scenes)
+    for (const fs::path& f : scene_input_files(s)) inputs.push_back(f);
+  lock = std::make_unique<OutputDir>(out, OutputKind::Sweep, inputs);
   if (fresh || o.restart) {
     // Beginning again: earlier records are kept aside, never silently mixed with the new ones.
     keep_aside(records_file);

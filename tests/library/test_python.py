@@ -83,6 +83,25 @@ def main():
     except ValueError as e:
         check(f"the message names the file: {e}", "no-such-scene.toml" in str(e))
 
+    # A dict that contains itself, or nests without bound, is a ValueError, not a crashed interpreter.
+    cyclic = tomllib.loads(Path(scene).read_text())
+    cyclic["body"]["self"] = cyclic
+    try:
+        tippe.run_scene(cyclic)
+        check("a dict that contains itself is refused", False)
+    except ValueError as e:
+        check(f"the message names the cycle: {e}", "body.self" in str(e) and "contains itself" in str(e))
+    deep = tomllib.loads(Path(scene).read_text())
+    inner = deep["body"]
+    for _ in range(100000):
+        inner["x"] = {}
+        inner = inner["x"]
+    try:
+        tippe.run_scene(deep)
+        check("a dict nested 100000 deep is refused", False)
+    except ValueError as e:
+        check(f"the message says how deep: {e}", "nested deeper than 64" in str(e))
+
     if failures:
         print("FAILED:\n  " + "\n  ".join(failures))
         return 1

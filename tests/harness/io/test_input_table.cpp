@@ -13,6 +13,7 @@
 #include "gating/gate.h"
 #include "records/records.h"
 #include "io/scene_io.h"
+#include "io/toml_reader.h"
 #include "sweep/sweep.h"
 #include "support/files.h"
 #include "support/process.h"
@@ -50,6 +51,11 @@ std::vector<Case> cases() {
   std::string deep_tables = "[a";
   for (int i = 0; i < 300; ++i) deep_tables += ".a";
   deep_tables += "]\n";
+  // 100 KB, under the 1 MiB bound: toml++ recursed once per part and overflowed the stack.
+  std::string key_50000 = "a";
+  for (int i = 1; i < 50000; ++i) key_50000 += ".a";
+  std::string bounded_key = "a";
+  for (int i = 1; i < kMaxTomlKeyParts; ++i) bounded_key += ".a";
   std::string inline_body = "name = \"base\"\ngravity = 1\n"
                             "body = { sphere_radius = 1.0, stem_radius = 0.25, stem_length = 1.2, truncation_height = 0.9, "
                             "mass = 1.0, com_offset = 0.3, inertia_transverse = 0.4, inertia_axial = 0.45 }\n" +
@@ -68,7 +74,17 @@ std::vector<Case> cases() {
       // ---- structure: "FILE: KEY: reason"
       {"empty_file", "", {}, {": gravity: missing (required)"}},
       {"only_a_comment", "# a scene file with nothing in it\n", {}, {": gravity: missing (required)"}},
-      {"deeply_nested_tables", deep_tables + b, {}, {": a: unknown key"}},
+      {"deeply_nested_tables", deep_tables + b, {}, {":1:2:", "a dotted key or table header of more than 64 parts"}},
+      // ---- nesting bounded before toml++ recurses (hostile inputs, round 3)
+      {"table_header_of_50000_parts", "[" + key_50000 + "]\n" + b, {}, {":1:2:", "more than 64 parts"}},
+      {"array_table_header_of_50000_parts", b + "[[" + key_50000 + "]]\n", {}, {":25:3:", "more than 64 parts"}},
+      {"dotted_key_of_50000_parts", key_50000 + " = 1\n" + b, {}, {":1:1:", "more than 64 parts"}},
+      {"quoted_dotted_key_of_50000_parts", "\"a\"." + key_50000 + " = 1\n" + b, {}, {":1:1:", "more than 64 parts"}},
+      {"inline_table_key_of_50000_parts", "x = { " + key_50000 + " = 1 }\n" + b, {}, {":1:7:", "more than 64 parts"}},
+      {"key_at_the_bound_is_only_unknown", bounded_key + " = 1\n" + b, {}, {": a: unknown key"}},
+      {"set_key_of_50000_parts", b, {key_50000 + "=1"}, {": --set: the key a.a.a", "has 50000 parts, more than 64"}},
+      {"set_inline_table_of_50000_parts", b, {"description={" + key_50000 + "=1}"},
+       {": --set: the value of description nests dotted keys deeper than 64 parts"}},
       {"array_of_tables_for_a_table", edit(b, "[contact]", "[[contact]]"), {}, {": contact: expected a table, got an array"}},
       {"engines_not_a_table", "engines = 5\n" + b, {}, {": engines: expected a table of [engines.NAME] tables, got an integer"}},
       {"very_long_key", edit(b, "[body]\n", "[body]\n" + long_key + " = 1\n"), {}, {": body." + long_key + ": unknown key"}},

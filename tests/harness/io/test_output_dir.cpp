@@ -68,11 +68,11 @@ const std::vector<std::string> kLongRun = {"--engine", "ode", "--set", "run.dura
 TEST(OutputDir, ASecondWriterIsRefusedWhateverHappensToFilesInside) {
   TempDir dir{"tippe-outdir"};
   const fs::path out = dir.path() / "out";
-  OutputDir first(out);
+  OutputDir first(out, OutputKind::Run);
   EXPECT_TRUE(fs::is_directory(out));
   // The lock is the directory's own: no file in it to delete.
   EXPECT_TRUE(fs::is_empty(out));
-  EXPECT_THROW(OutputDir second(out), OutputError);
+  EXPECT_THROW(OutputDir second(out, OutputKind::Run), OutputError);
   const fs::path err = dir.path() / "err.txt";
   const ChildExit e = run_tippe({"run", kToy, "--set", "run.duration=0.01", "--out", out.string()}, err);
   EXPECT_EQ(e.code, 2) << slurp(err);
@@ -82,41 +82,51 @@ TEST(OutputDir, ASecondWriterIsRefusedWhateverHappensToFilesInside) {
 TEST(OutputDir, ASwapReplacesTheWholeSetAndLeavesNothingBeside) {
   TempDir dir{"tippe-outdir"};
   const fs::path out = dir.path() / "out";
-  spit(out / "old.txt", "old");
-  spit(out / "kept.txt", "kept");
   {
-    OutputDir d(out);
+    OutputDir d(out, OutputKind::Run);
+    const fs::path s = d.stage(false);
+    spit(s / "old.txt", "old");
+    spit(s / "kept.txt", "kept");
+    d.commit();
+  }
+  EXPECT_EQ(tree(out), (std::vector<std::string>{kOutputMarker, "kept.txt", "old.txt"}));
+  {
+    OutputDir d(out, OutputKind::Run);
     const fs::path s = d.stage(false);
     EXPECT_EQ(s.parent_path(), fs::absolute(dir.path()));
     spit(s / "new.txt", "new");
     EXPECT_TRUE(fs::exists(out / "old.txt")) << "nothing changes before the commit";
     d.commit();
   }
-  EXPECT_EQ(tree(out), std::vector<std::string>{"new.txt"});
+  EXPECT_EQ(tree(out), (std::vector<std::string>{kOutputMarker, "new.txt"}));
   EXPECT_TRUE(leftovers(dir.path()).empty());
   {
     // A unit rebuilt beside the records keeps them, as links until replaced.
-    OutputDir d(out);
+    OutputDir d(out, OutputKind::Run);
     const fs::path s = d.stage(true);
     EXPECT_EQ(slurp(s / "new.txt"), "new");
     write_file_atomic((s / "report.md").string(), "report");
     d.commit();
   }
-  EXPECT_EQ(tree(out), (std::vector<std::string>{"new.txt", "report.md"}));
+  EXPECT_EQ(tree(out), (std::vector<std::string>{kOutputMarker, "new.txt", "report.md"}));
   EXPECT_TRUE(leftovers(dir.path()).empty());
 }
 
 TEST(OutputDir, WithoutACommitTheOldSetStaysAndANewEmptyDirectoryGoes) {
   TempDir dir{"tippe-outdir"};
   const fs::path out = dir.path() / "out", fresh = dir.path() / "fresh";
-  spit(out / "old.txt", "old");
   {
-    OutputDir d(out);
+    OutputDir d(out, OutputKind::Run);
+    spit(d.stage(false) / "old.txt", "old");
+    d.commit();
+  }
+  {
+    OutputDir d(out, OutputKind::Run);
     spit(d.stage(false) / "half.txt", "half");
   }
-  EXPECT_EQ(tree(out), std::vector<std::string>{"old.txt"});
+  EXPECT_EQ(tree(out), (std::vector<std::string>{kOutputMarker, "old.txt"}));
   {
-    OutputDir d(fresh);
+    OutputDir d(fresh, OutputKind::Run);
     d.stage(false);
   }
   EXPECT_FALSE(fs::exists(fresh));
@@ -127,14 +137,14 @@ TEST(OutputDir, StagingThatAKilledRunLeftIsRemoved) {
   TempDir dir{"tippe-outdir"};
   const fs::path out = dir.path() / "out", stale = dir.path() / ".out.staging-999999999";
   spit(stale / "half.txt", "half");
-  OutputDir d(out);
+  OutputDir d(out, OutputKind::Run);
   EXPECT_FALSE(fs::exists(stale));
 }
 
 TEST(OutputDir, AFileIsNotADirectory) {
   TempDir dir{"tippe-outdir"};
   const std::string file = dir.write("file.txt", "x");
-  EXPECT_THROW(OutputDir d(file), OutputError);
+  EXPECT_THROW(OutputDir d(file, OutputKind::Run), OutputError);
   const fs::path err = dir.path() / "err.txt";
   for (const std::string cmd : {"run", "compare"}) {
     std::vector<std::string> args = {cmd, kToy, "--set", "run.duration=0.01", "--out", file};

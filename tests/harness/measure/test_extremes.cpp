@@ -81,8 +81,11 @@ TEST(ExtremesRecords, OldRecordsTakeTheirClassFromTheStatus) {
   EXPECT_EQ(back.run_class, "diverged");
   EXPECT_TRUE(std::isnan(back.class_time));
   EXPECT_FALSE(back.reference.has_value());
-  j["status"] = "some_new_status";
+  j["status"] = "unphysical";
   EXPECT_EQ(sweep_record_from_json(j).run_class, "failed");
+  // Records are input: a status outside the known set is refused, not read as "failed".
+  j["status"] = "some_new_status";
+  EXPECT_ANY_THROW(sweep_record_from_json(j));
 }
 
 TEST(ExtremesReport, StabilityMapHasOneCellPerPointColouredByClass) {
