@@ -56,17 +56,14 @@ std::optional<Finding> first_divergence(const Trajectory& tr) {
 }
 
 std::optional<Finding> first_energy_gain(const Trajectory& tr) {
-  if (tr.size() < 2) return std::nullopt;
-  const double e0 = std::abs(tr.energy[0]);
-  const double threshold = kEnergyGainTolerance * e0;
-  for (size_t k = 1; k < tr.size(); ++k) {
-    const double rise = tr.energy[k] - tr.energy[k - 1];
-    if (rise > threshold)
-      return Finding{tr.t[k], "energy rose by " + num(e0 > 0 ? rise / e0 : rise) + (e0 > 0 ? " E0" : "") +
-                                  " between t = " + num(tr.t[k - 1]) + " and " + num(tr.t[k]) +
-                                  " in a dissipative scene (tolerance " + num(kEnergyGainTolerance) + " E0)"};
-  }
-  return std::nullopt;
+  // The rule of metrics.h (energy_gains): the same measurement as energy_gain_events.
+  const EnergyGains g = energy_gains(tr);
+  if (!g.events) return std::nullopt;
+  const bool relative = tr.energy[0] != 0;
+  return Finding{g.time, "energy rose by " + num(g.rise_at_first) + (relative ? " E0" : "") + " between t = " +
+                             num(g.since) + " (its lowest so far) and " + num(g.time) +
+                             " in a dissipative scene (tolerance " + num(kEnergyGainTolerance) +
+                             " E0 on the net rise)"};
 }
 
 std::optional<double> record_drift(const RunRecord& run, int surface) {
@@ -178,7 +175,7 @@ RunClass classify_run(const Scene& scene, const RunRecord& run, const Metrics* v
     const double nan = std::nan("");
     if (vs_reference && energy_must_not_rise(scene) && vs_reference->energy_gain_events > 0)
       return {RunClassKind::Unphysical, nan,
-              std::to_string(vs_reference->energy_gain_events) + " energy rises above " + num(kEnergyGainTolerance) +
+              std::to_string(vs_reference->energy_gain_events) + " net energy rises above " + num(kEnergyGainTolerance) +
                   " E0 in a dissipative scene (largest " + num(vs_reference->energy_max_gain) +
                   " E0; no trajectory to date them)"};
   }

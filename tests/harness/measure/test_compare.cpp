@@ -544,7 +544,7 @@ TEST(Report, HtmlIsWellFormedWithPlotsAndFooter) {
   EXPECT_NE(md.find("| engine | status | inversion t |"), std::string::npos);
   EXPECT_NE(md.find("bullet: status diverged at t = 1"), std::string::npos) << md;
   EXPECT_NE(md.find("bullet: no inversion"), std::string::npos) << md;
-  EXPECT_NE(md.find("bullet: energy rose between samples 1 time"), std::string::npos) << md;
+  EXPECT_NE(md.find("bullet: energy rose above its lowest earlier value 1 time"), std::string::npos) << md;
   EXPECT_NE(md.find("## Provenance"), std::string::npos);
 }
 
