@@ -142,6 +142,12 @@ const EngineInfo& bullet_engine_info() {
     set_settings_struct<BulletSettings>(e);
     e.version = "bullet " + std::to_string(BT_BULLET_VERSION / 100) + "." + std::to_string(BT_BULLET_VERSION % 100);
     e.colour = "#D55E00";  // Okabe-Ito vermillion
+    // The sequential-impulse solver's iterations, split impulse (position correction kept out of
+    // the velocities) and the gyroscopic integration.
+    e.advice_axes = {{"solver_iterations", {"50", "10"}},
+                     {"split_impulse", {"true", "false"}},
+                     {"gyroscopic", {"\"implicit_body\"", "\"explicit\""}}};
+    e.cost_knob = "timestep";
     return e;
   }();
   return info;

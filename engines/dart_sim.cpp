@@ -377,6 +377,9 @@ const EngineInfo& dart_engine_info() {
     set_settings_struct<DartSettings>(e);
     e.version = std::string("dart ") + DART_VERSION;
     e.colour = "#E69F00";  // Okabe-Ito orange
+    // The LCP solver: Dantzig's pivoting (exact) or projected Gauss-Seidel (iterative).
+    e.advice_axes = {{"lcp_solver", {"\"dantzig\"", "\"pgs\""}}};
+    e.cost_knob = "timestep";
     return e;
   }();
   return info;

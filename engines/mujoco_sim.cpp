@@ -481,6 +481,13 @@ const EngineInfo& mujoco_engine_info() {
     e.default_settings = [] { return list_settings(MujocoSettings{}); };
     e.version = std::string("mujoco ") + mj_versionString();
     e.colour = "#009E73";  // Okabe-Ito bluish green
+    // The integrator decides how the gyroscopic term and the contact's stiffness are integrated
+    // (Euler's energy rises scale with the step; RK4 is 4th order), the cone which friction law
+    // is solved, noslip whether the soft friction's creep is removed.
+    e.advice_axes = {{"integrator", {"\"RK4\"", "\"Euler\"", "\"implicit\""}},
+                     {"cone", {"\"elliptic\"", "\"pyramidal\""}},
+                     {"noslip_iterations", {"0", "10"}}};
+    e.cost_knob = "timestep";
     return e;
   }();
   return info;

@@ -531,6 +531,10 @@ const EngineInfo& ode_engine_info() {
     set_settings_struct<OdeSettings>(e, [](const OdeSettings& s, const Scene& scene) { check_combination(s, scene); });
     e.version = std::string("ode ") + dODE_VERSION;
     e.colour = "#0072B2";  // Okabe-Ito blue
+    // The step function (dWorldStep's exact LCP against quickstep's iterations) and the
+    // orientation update (finite rotation, exact for a constant spin, or ODE's infinitesimal one).
+    e.advice_axes = {{"stepper", {"\"step\"", "\"quickstep\""}}, {"finite_rotation", {"true", "false"}}};
+    e.cost_knob = "timestep";
     return e;
   }();
   return info;
