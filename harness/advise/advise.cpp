@@ -393,7 +393,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
     doc.para(t, "verdict");
   }
   doc.para(std::string("Safe: the run finished, the stability map classes it ok (no divergence, no net energy gain "
-                       "above 1e-6 E0 in a dissipative scene, no Jellett drift where J is conserved), and ") +
+                       "above 1e-6 E0 and the energy of 1e-4 R of contact depth in a dissipative scene, no Jellett drift where J is conserved), and ") +
            res.criterion + ". The advised " + "step is the largest safe step found / " + g3(kAdviceMargin) +
            ", confirmed by a run there. " +
            (res.gate_written ? "advice.toml is the gate that keeps it: `tippe gate advice.toml`."

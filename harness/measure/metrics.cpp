@@ -96,12 +96,18 @@ bool energy_must_not_rise(const Scene& scene) {
          (c.friction == FrictionLaw::Gliding && c.mu > 0);
 }
 
-EnergyGains energy_gains(const Trajectory& tr) {
+double contact_energy_allowance(const Scene& scene) {
+  const double a = scene.mass.mass * scene.gravity * kContactDepthResolution * scene.body.sphere_radius;
+  return std::isfinite(a) && a > 0 ? a : 0.0;
+}
+
+EnergyGains energy_gains(const Trajectory& tr, double allowance) {
   EnergyGains g;
   if (tr.size() < 2) return g;
   const double e0 = std::abs(tr.energy[0]);
   const double scale = e0 > 0 ? e0 : 1.0;
-  const double threshold = kEnergyGainTolerance * scale;
+  const double threshold = kEnergyGainTolerance * scale + allowance;
+  g.tolerance = threshold / scale;
   double low = tr.energy[0], low_t = tr.t[0];
   bool above = false;
   for (size_t k = 1; k < tr.size(); ++k) {
@@ -185,7 +191,7 @@ Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, con
     const double E0 = engine_traj.energy.front();
     m.energy_final_ratio = engine_traj.energy.back() / E0;
     if (energy_must_not_rise(scene)) {
-      const EnergyGains g = energy_gains(engine_traj);
+      const EnergyGains g = energy_gains(engine_traj, contact_energy_allowance(scene));
       m.energy_gain_events = g.events;
       m.energy_max_gain = g.events ? g.max_rise : 0.0;
     }

@@ -287,7 +287,7 @@ std::vector<std::string> report_findings(const json& c) {
     if (gains > 0)
       out.push_back(engine + ": energy rose above its lowest earlier value " + std::to_string(gains) + " time" +
                     (gains == 1 ? "" : "s") + " by more than " + fmt(kEnergyGainTolerance, "%g") +
-                    " E0 (largest net rise " + fmt(num(m, "energy_max_gain"), "%.3g") +
+                    " E0 and the energy of 1e-4 R of contact depth (largest net rise " + fmt(num(m, "energy_max_gain"), "%.3g") +
                     " E0) although the contact law dissipates");
   }
   return out;

@@ -437,9 +437,12 @@ Document build_doc(const std::vector<SweepRecord>& records, const std::vector<st
   const std::vector<std::string> verdicts = sweep_verdicts(scenes);
   for (const std::string& v : verdicts) doc.para(v, "verdict");
   if (!verdicts.empty())
-    doc.para("A point counts as in the reference's regime when it inverts where the reference does and finishes "
-             "without inverting where it does not; points the stability map classes unphysical or diverged never "
-             "count, nor are they ever the setting to use.",
+    doc.para("Safe, the one criterion of this page's sentences, its tables, its boundary searches and the gates: "
+             "the run finished (status ok), the stability map classes it ok, and it is in the reference's regime "
+             "(it inverts where the reference does and finishes without inverting where it does not, judged inside "
+             "the reference's converged window); where the reference inverts, the setting to use also has its "
+             "inversion time within 1 % (10 % when no point is). Points the stability map classes "
+             "unphysical or diverged never count, nor are they ever the setting to use.",
              "note");
   size_t points = 0;
   std::set<std::string> setups, commits;

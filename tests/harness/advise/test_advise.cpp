@@ -63,7 +63,7 @@ TEST(Advise, FindsTheBoundaryInLogRunsAndWritesAGateThatHolds) {
   ASSERT_EQ(confirm.size(), 1u);
   const SearchCriterion c = parse_criterion("regime and inversion within 10%");
   EXPECT_TRUE(is_safe(c, confirm[0])) << unsafe_reason(c, confirm[0]);
-  EXPECT_NEAR(confirm[0].ladder_value, *b[0].boundary / kAdviceMargin, 1e-6 * *b[0].boundary);
+  EXPECT_EQ(confirm[0].ladder_value, search_round(*b[0].boundary / kAdviceMargin));
 
   // The gate passes as written ...
   const fs::path gate = out / "advice.toml";

@@ -347,7 +347,7 @@ TEST(Classify, WithoutTrajectoryTheSummariesDecide) {
   RunClass c = classify_run(viscous_scene(), ok_run(), &m, none);
   EXPECT_EQ(c.kind, RunClassKind::Unphysical);
   EXPECT_TRUE(std::isnan(c.time));
-  EXPECT_NE(c.reason.find("3 energy rises"), std::string::npos) << c.reason;
+  EXPECT_NE(c.reason.find("3 net energy rises"), std::string::npos) << c.reason;
 
   RunRecord r = ok_run();
   r.jellett_drift_ball = 5e-4;
