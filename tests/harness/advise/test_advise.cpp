@@ -3,12 +3,13 @@
 
 #include <cmath>
 #include <filesystem>
-#include <regex>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "advise/advise.h"
 #include "gating/gate_boundary.h"
+#include "registry.h"
 #include "report/sweep_analysis.h"
 #include "support/files.h"
 #include "support/fixtures.h"
@@ -94,6 +95,26 @@ TEST(Advise, NothingSafeInRangeSaysSoAndPinsNoGate) {
   EXPECT_NE(text.find("gate: none"), std::string::npos) << text;
   EXPECT_FALSE(fs::exists(out / "advice.toml"));
   EXPECT_NE(slurp(out / "index.md").find("no advice"), std::string::npos);
+}
+
+TEST(Advise, ConfigurationsComeFromTheRegistry) {
+  // Every combination of the axes each engine declares, the engine's defaults first.
+  for (const std::string& n : engine_names()) {
+    const EngineInfo& e = engine_info(n);
+    size_t combos = 1;
+    for (const SettingAxis& a : e.advice_axes) combos *= a.values.size();
+    const std::vector<AdviceConfig> c = advice_configs(n, {});
+    EXPECT_EQ(c.size(), combos) << n;
+    EXPECT_FALSE(e.cost_knob.empty()) << n << " declares no cost knob";
+    std::set<std::string> setups;
+    for (const AdviceConfig& x : c) EXPECT_TRUE(setups.insert(x.setup).second) << x.setup;
+  }
+  const std::vector<AdviceConfig> m = advice_configs("mujoco", {"mujoco.integrator=\"Euler\"", "ode.stepper=\"step\""});
+  ASSERT_EQ(m.size(), 4u) << "the integrator fixed, the cone and noslip free; another engine's axis ignored";
+  EXPECT_EQ(m.front().text(), "integrator = Euler, cone = elliptic, noslip_iterations = 0");
+  EXPECT_EQ(m.front().set().front(), "engines.mujoco.integrator=\"Euler\"");
+  EXPECT_THROW(advice_configs("mujoco", {"mujoco.nope=1"}), std::invalid_argument);
+  EXPECT_THROW(advice_configs("mujoco", {"mujoco.cone="}), std::invalid_argument);
 }
 
 // ---- one criterion: the same records give the same answer everywhere -------------------------
