@@ -134,9 +134,18 @@ std::unique_ptr<Simulator> make_bullet_simulator(const Scene& scene) {
 void validate_bullet_settings(const Scene& scene) { (void)read_settings<BulletSettings>("bullet", scene); }
 
 const EngineInfo& bullet_engine_info() {
-  static const EngineInfo info = engine_entry<BulletSettings>(  // Okabe-Ito vermillion
-      "bullet", EngineRole::Engine, make_bullet_simulator,
-      "bullet " + std::to_string(BT_BULLET_VERSION / 100) + "." + std::to_string(BT_BULLET_VERSION % 100), "#D55E00");
+  static const EngineInfo info = [] {
+    EngineInfo e = engine_entry<BulletSettings>(  // Okabe-Ito vermillion
+        "bullet", EngineRole::Engine, make_bullet_simulator,
+        "bullet " + std::to_string(BT_BULLET_VERSION / 100) + "." + std::to_string(BT_BULLET_VERSION % 100), "#D55E00");
+    // The sequential-impulse solver's iterations, split impulse (position correction kept out of
+    // the velocities) and the gyroscopic integration.
+    e.advice_axes = {{"solver_iterations", {"50", "10"}},
+                     {"split_impulse", {"true", "false"}},
+                     {"gyroscopic", {"\"implicit_body\"", "\"explicit\""}}};
+    e.cost_knob = "timestep";
+    return e;
+  }();
   return info;
 }
 

@@ -122,8 +122,21 @@ void FixedStepSimulator::fail(RunStatus s, double t, const std::string& why) {
 }
 
 void FixedStepSimulator::advance_to(double t) {
-#include "../../analytic/stop_request.h"
-#include "settings.h"
+  // The step budget ends a run that would take more steps (to t, or over the scene's duration) as
+  // failed, before it starts them.
+  const double horizon = std::max(t, scene_.run.duration);
+  if (status_ == RunStatus::Ok && horizon / dt_ > static_cast<double>(kMaxEngineSteps)) {
+    fail(RunStatus::Failed, time(),
+         "step budget: a run to t = " + round_trip_text(horizon) + " takes " + round_trip_text(std::ceil(horizon / dt_)) +
+             " steps of " + round_trip_text(dt_) + ", more than the budget of " + std::to_string(kMaxEngineSteps));
+    return;
+  }
+  // Steps whose end lies within half a step of t count as reaching t. A signal ends the run
+  // within kStepsPerStopPoll steps (Interrupted, see analytic/stop_request.h).
+  while (status_ == RunStatus::Ok && (static_cast<double>(n_steps_) + 0.5) * dt_ <= t) {
+    if (n_steps_ % kStepsPerStopPoll == 0) poll_stop();
+    step_once();
+  }
 }
 
 void FixedStepSimulator::step_once() {

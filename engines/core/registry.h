@@ -15,6 +15,14 @@ namespace tippe {
 // The reference is what every engine is measured against; there is exactly one.
 enum class EngineRole { Reference, Engine };
 
+// One accuracy-relevant setting of an engine that `tippe advise` searches over: a key of the
+// engine's [engines.NAME] table and its admissible values, each written as a TOML value
+// ("\"RK4\"", "10", "true"), the engine's default first.
+struct SettingAxis {
+  std::string key;
+  std::vector<std::string> values;
+};
+
 struct EngineInfo {
   std::string name;      // as in --engine, [engines.NAME] and records
   EngineRole role = EngineRole::Engine;
@@ -27,6 +35,13 @@ struct EngineInfo {
   // The reference only: writes its [engines.NAME] table into scene.run (the values the
   // reference and the harness read), so that [run]'s older keys and the table agree.
   std::function<void(Scene&)> adopt;
+  // What `tippe advise` searches: the categorical axes (every combination is one configuration)
+  // and the cost knob, a key of [engines.NAME] whose larger values are cheaper and softer (the
+  // time step), searched for its boundary in each configuration. Each adapter declares its own
+  // next to its registration; an engine without axes is searched in its defaults alone, and one
+  // without a cost knob is not advised.
+  std::vector<SettingAxis> advice_axes;
+  std::string cost_knob;
   std::string version;   // library version, as Simulator::version() reports it
   std::string colour;    // plot colour (#rrggbb) in every report
 };

@@ -303,8 +303,14 @@ MassReadback DartSimulator::mass_properties() const {
 std::unique_ptr<Simulator> make_dart_simulator(const Scene& scene) { return std::make_unique<DartSimulator>(scene); }
 
 const EngineInfo& dart_engine_info() {
-  static const EngineInfo info = engine_entry<DartSettings>(  // Okabe-Ito orange
-      "dart", EngineRole::Engine, make_dart_simulator, std::string("dart ") + DART_VERSION, "#E69F00");
+  static const EngineInfo info = [] {
+    EngineInfo e = engine_entry<DartSettings>(  // Okabe-Ito orange
+        "dart", EngineRole::Engine, make_dart_simulator, std::string("dart ") + DART_VERSION, "#E69F00");
+    // The LCP solver: Dantzig's pivoting (exact) or projected Gauss-Seidel (iterative).
+    e.advice_axes = {{"lcp_solver", {"\"dantzig\"", "\"pgs\""}}};
+    e.cost_knob = "timestep";
+    return e;
+  }();
   return info;
 }
 

@@ -467,6 +467,13 @@ const EngineInfo& mujoco_engine_info() {
         "mujoco", EngineRole::Engine, make_mujoco_simulator, std::string("mujoco ") + mj_versionString(), "#009E73");
     // Its checks and, for the user's own model, MuJoCo compiling it.
     e.validate = validate_mujoco_settings;
+    // The integrator decides how the gyroscopic term and the contact's stiffness are integrated
+    // (Euler's energy rises scale with the step; RK4 is 4th order), the cone which friction law
+    // is solved, noslip whether the soft friction's creep is removed.
+    e.advice_axes = {{"integrator", {"\"RK4\"", "\"Euler\"", "\"implicit\""}},
+                     {"cone", {"\"elliptic\"", "\"pyramidal\""}},
+                     {"noslip_iterations", {"0", "10"}}};
+    e.cost_knob = "timestep";
     return e;
   }();
   return info;

@@ -434,9 +434,16 @@ std::unique_ptr<Simulator> make_ode_simulator(const Scene& scene) {
 void validate_ode_settings(const Scene& scene) { check_combination(read_settings<OdeSettings>("ode", scene), scene); }
 
 const EngineInfo& ode_engine_info() {
-  static const EngineInfo info = engine_entry<OdeSettings>(  // Okabe-Ito blue
-      "ode", EngineRole::Engine, make_ode_simulator, std::string("ode ") + dODE_VERSION, "#0072B2",
-      [](const OdeSettings& s, const Scene& scene) { check_combination(s, scene); });
+  static const EngineInfo info = [] {
+    EngineInfo e = engine_entry<OdeSettings>(  // Okabe-Ito blue
+        "ode", EngineRole::Engine, make_ode_simulator, std::string("ode ") + dODE_VERSION, "#0072B2",
+        [](const OdeSettings& s, const Scene& scene) { check_combination(s, scene); });
+    // The step function (dWorldStep's exact LCP against quickstep's iterations) and the
+    // orientation update (finite rotation, exact for a constant spin, or ODE's infinitesimal one).
+    e.advice_axes = {{"stepper", {"\"step\"", "\"quickstep\""}}, {"finite_rotation", {"true", "false"}}};
+    e.cost_knob = "timestep";
+    return e;
+  }();
   return info;
 }
 

@@ -483,6 +483,10 @@ const EngineInfo& simbody_engine_info() {
     set_settings_struct<SimbodySettings>(e, [](const SimbodySettings& s, const Scene& scene) { check_combination(s, scene); });
     e.version = simbody_version();
     e.colour = "#56B4E9";  // Okabe-Ito sky blue
+    // Simbody's cost knob is its error control's accuracy, not a step; the integrator decides
+    // what that accuracy buys (RK-Merson and RK3 explicit, CPodes implicit for a stiff contact).
+    e.advice_axes = {{"integrator", {"\"rk_merson\"", "\"rk3\"", "\"cpodes\""}}};
+    e.cost_knob = "accuracy";
     return e;
   }();
   return info;

@@ -102,6 +102,7 @@ Command setup_compare(CLI::App& app);  // and setup_report, in cli_compare.cpp
 Command setup_report(CLI::App& app);
 Command setup_sweep(CLI::App& app);
 Command setup_gate(CLI::App& app);
+Command setup_advise(CLI::App& app);
 
 // The common SCENE.toml positional and repeatable --set KEY=VALUE option.
 inline void add_scene_options(CLI::App* sub, std::string& scene, std::vector<std::string>& sets) {

@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
   // Adding a subcommand: write cli_NAME.cpp with setup_NAME, declare it in cli.h, list it here.
   const cli::Setup commands[] = {cli::setup_run, cli::setup_export_mjcf, cli::setup_import_mjcf, cli::setup_info,
                                   cli::setup_compare, cli::setup_report, cli::setup_sweep,
-                                  cli::setup_gate};
+                                  cli::setup_gate, cli::setup_advise};
   std::map<const CLI::App*, cli::Action> actions;
   for (cli::Setup setup : commands) {
     cli::Command c = setup(app);

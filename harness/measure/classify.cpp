@@ -55,18 +55,15 @@ std::optional<Finding> first_divergence(const Trajectory& tr) {
   return std::nullopt;
 }
 
-std::optional<Finding> first_energy_gain(const Trajectory& tr) {
-  if (tr.size() < 2) return std::nullopt;
-  const double e0 = std::abs(tr.energy[0]);
-  const double threshold = kEnergyGainTolerance * e0;
-  for (size_t k = 1; k < tr.size(); ++k) {
-    const double rise = tr.energy[k] - tr.energy[k - 1];
-    if (rise > threshold)
-      return Finding{tr.t[k], "energy rose by " + num(e0 > 0 ? rise / e0 : rise) + (e0 > 0 ? " E0" : "") +
-                                  " between t = " + num(tr.t[k - 1]) + " and " + num(tr.t[k]) +
-                                  " in a dissipative scene (tolerance " + num(kEnergyGainTolerance) + " E0)"};
-  }
-  return std::nullopt;
+std::optional<Finding> first_energy_gain(const Scene& scene, const Trajectory& tr) {
+  // The rule of metrics.h (energy_gains): the same measurement as energy_gain_events.
+  const EnergyGains g = energy_gains(tr, contact_energy_allowance(scene));
+  if (!g.events) return std::nullopt;
+  const bool relative = tr.energy[0] != 0;
+  return Finding{g.time, "energy rose by " + num(g.rise_at_first) + (relative ? " E0" : "") + " between t = " +
+                             num(g.since) + " (its lowest so far) and " + num(g.time) +
+                             " in a dissipative scene (tolerance " + num(g.tolerance) +
+                             " E0 on the net rise: 1e-06 E0 and the energy of 1e-4 R of contact depth)"};
 }
 
 std::optional<double> record_drift(const RunRecord& run, int surface) {
@@ -134,7 +131,7 @@ std::optional<Finding> first_jellett_drift(const Trajectory& tr, const RunRecord
 // samples cannot date comes last).
 std::optional<Finding> first_unphysical(const Scene& scene, const RunRecord& run, const Trajectory& tr) {
   std::optional<Finding> gain, drift;
-  if (energy_must_not_rise(scene)) gain = first_energy_gain(tr);
+  if (energy_must_not_rise(scene)) gain = first_energy_gain(scene, tr);
   if (jellett_must_hold(scene)) drift = first_jellett_drift(tr, run);
   if (gain && drift) return !(drift->time < gain->time) ? gain : drift;
   return gain ? gain : drift;
@@ -178,8 +175,8 @@ RunClass classify_run(const Scene& scene, const RunRecord& run, const Metrics* v
     const double nan = std::nan("");
     if (vs_reference && energy_must_not_rise(scene) && vs_reference->energy_gain_events > 0)
       return {RunClassKind::Unphysical, nan,
-              std::to_string(vs_reference->energy_gain_events) + " energy rises above " + num(kEnergyGainTolerance) +
-                  " E0 in a dissipative scene (largest " + num(vs_reference->energy_max_gain) +
+              std::to_string(vs_reference->energy_gain_events) + " net energy rises above the tolerance (" + num(kEnergyGainTolerance) +
+                  " E0 and the energy of 1e-4 R of contact depth) in a dissipative scene (largest " + num(vs_reference->energy_max_gain) +
                   " E0; no trajectory to date them)"};
   }
   return out;

@@ -48,8 +48,9 @@ bool jellett_must_hold(const Scene& scene);
 //     divergence checks of the engines (G below the floor by more than R/10, speed blow-up)
 //     need the full state, which a Trajectory does not carry: they reach this function through
 //     the engine's status.
-//  3. Otherwise, unphysical at the earlier of: the first sample where E rose by more than
-//     kEnergyGainTolerance * |E0| over the previous one in a scene where energy_must_not_rise;
+//  3. Otherwise, unphysical at the earlier of: the first sample where E stands more than
+//     kEnergyGainTolerance * |E0| above the lowest E of the samples before it (a net rise, the
+//     rule of metrics.h, energy_gains) in a scene where energy_must_not_rise;
 //     in a scene where jellett_must_hold, a Jellett drift beyond kJellettDriftTolerance. Whether
 //     J drifted is the record's jellett_drift_ball/stem (computed during the run from every
 //     sample and switch event); the time is the first sample where J has moved that far from

@@ -21,8 +21,8 @@ struct Metrics {
   double tilt_max_error = 0, tilt_rms_error = 0;              // rad, on the common grid
   double energy_max_error = 0;                                // max |E - E_ref| / E0
   double energy_final_ratio = 0;                              // E_final / E0 of the engine
-  long long energy_gain_events = 0;                           // dissipative scenes: rises above tolerance
-  double energy_max_gain = 0;                                 // largest rise, / E0
+  long long energy_gain_events = 0;                           // dissipative scenes: net rises above tolerance (metrics.h)
+  double energy_max_gain = 0;                                 // largest net rise, / E0
   double contact_path_rms_error = 0, contact_path_max_error = 0;  // floor contact path, / R
   double com_path_rms_error = 0, com_path_max_error = 0;          // path of G (x, y), / R
   double latitude_rms_error = 0;                              // contact latitude on the ball, rad

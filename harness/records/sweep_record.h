@@ -166,17 +166,41 @@ std::string grid_text(const SweepRecord& r);
 constexpr double kMinSearchResolution = 1e-3, kMaxSearchResolution = 1.0;
 constexpr int kMaxSearchPerDecade = 20;
 constexpr double kMaxSearchDecades = 20;
-// ---- a search's criterion ------------------------------------------------------------------
+// ---- the one criterion of "safe" --------------------------------------------------------------
 
-// "regime": in the reference's regime (agrees_with_reference_regime). "METRIC <= BOUND": the run
-// finished (status ok, as a gate check requires by default) and |METRIC| <= BOUND (threshold_row:
-// an absent or NaN metric fails).
+// Whether a point is a setting a user may rely on. Every reader that decides it calls
+// is_safe: the boundary search, the sweep page's "setting to use" and its regime counts, the
+// gates on a search's boundary ([[boundary]]) and `tippe advise`. Its terms, all required:
+//  - the run finished (status ok) and the stability map classes it ok: a run that ends in time
+//    having diverged or broken a conservation law (classify.h: an energy rise in a dissipative
+//    scene, Jellett's J drifting where it is conserved) is no setting to use, whatever else it got
+//    right;
+//  - `regime`: in the reference's regime (agrees_with_reference_regime), judged only inside the
+//    reference's converged window: an inversion pairing "unconverged" (the reference's or the
+//    run's inversion after its self-check parted) is not safe, since nothing is known there;
+//  - `inversion`: where the reference inverts, the run inverts too and |relative inversion-time
+//    error| <= the tolerance (a term that asks nothing where the reference does not invert);
+//  - each `bounds` entry: |METRIC| <= BOUND (threshold_row's rule: an absent or NaN metric fails).
+// Text form (parse_criterion): terms joined by " and ": "regime", "inversion within 1%" (or a
+// fraction: "inversion within 0.01"), "METRIC <= BOUND". "regime" and "METRIC <= BOUND" alone
+// read as they did before the terms could be combined.
 struct SearchCriterion {
   bool regime = true;
-  Threshold bound;
+  std::optional<double> inversion;  // the tolerance on |inversion_time_rel_error|, as a fraction
+  std::vector<Threshold> bounds;
+  // The one metric bound of a single "METRIC <= BOUND" criterion (what a search's not_applicable
+  // status is about); nullptr otherwise.
+  const Threshold* only_bound() const { return !regime && !inversion && bounds.size() == 1 ? &bounds.front() : nullptr; }
 };
 // Throws std::invalid_argument with the reason.
 SearchCriterion parse_criterion(const std::string& text);
-bool criterion_passes(const SearchCriterion& c, const SweepRecord& r);
+// The criterion as text, in parse_criterion's form (what pages and gate files print).
+std::string criterion_text(const SearchCriterion& c);
+// The one predicate: see SearchCriterion.
+bool is_safe(const SearchCriterion& c, const SweepRecord& r);
+// The same with a reason when it fails ("" when safe): the first term that failed.
+std::string unsafe_reason(const SearchCriterion& c, const SweepRecord& r);
+// The search's name for is_safe (kept for its readers).
+inline bool criterion_passes(const SearchCriterion& c, const SweepRecord& r) { return is_safe(c, r); }
 
 }  // namespace tippe

@@ -285,9 +285,9 @@ std::vector<std::string> report_findings(const json& c) {
     }
     const long long gains = m.value("energy_gain_events", 0LL);
     if (gains > 0)
-      out.push_back(engine + ": energy rose between samples " + std::to_string(gains) + " time" +
+      out.push_back(engine + ": energy rose above its lowest earlier value " + std::to_string(gains) + " time" +
                     (gains == 1 ? "" : "s") + " by more than " + fmt(kEnergyGainTolerance, "%g") +
-                    " E0 (largest rise " + fmt(num(m, "energy_max_gain"), "%.3g") +
+                    " E0 and the energy of 1e-4 R of contact depth (largest net rise " + fmt(num(m, "energy_max_gain"), "%.3g") +
                     " E0) although the contact law dissipates");
   }
   return out;

@@ -121,8 +121,31 @@ long long cheapest_where(const std::vector<SweepRecord>& records, const std::fun
 
 }  // namespace
 
+long long cheapest_safe(const std::vector<SweepRecord>& records, const SearchCriterion& c) {
+  long long best = -1;
+  for (size_t i = 0; i < records.size(); ++i) {
+    const SweepRecord& r = records[i];
+    if (!is_safe(c, r) || !std::isfinite(r.cpu_seconds)) continue;
+    if (best < 0) {
+      best = static_cast<long long>(i);
+      continue;
+    }
+    const SweepRecord& b = records[static_cast<size_t>(best)];
+    if (r.cpu_seconds < b.cpu_seconds || (r.cpu_seconds == b.cpu_seconds && r.steps < b.steps))
+      best = static_cast<long long>(i);
+  }
+  return best;
+}
+
+SearchCriterion setting_criterion(bool reference_inverts, double tolerance) {
+  SearchCriterion c;
+  c.regime = true;
+  if (reference_inverts) c.inversion = tolerance;
+  return c;
+}
+
 long long cheapest_below(const std::vector<SweepRecord>& records, double threshold) {
-  return cheapest_where(records, [threshold](double e) { return e < threshold; });
+  return cheapest_safe(records, setting_criterion(true, threshold));
 }
 
 long long cheapest_at_least_as_accurate(const std::vector<SweepRecord>& records, double error) {
@@ -146,7 +169,7 @@ long long softest_agreeing(const std::vector<SweepRecord>& records) {
   });
   long long softest = -1;
   for (size_t i : order) {
-    if (!agrees_with_reference_regime(records[i])) break;
+    if (!is_safe(setting_criterion(false, 0), records[i])) break;
     softest = static_cast<long long>(i);
   }
   return softest;

@@ -23,14 +23,20 @@ struct ConvergenceFit {
 // h and error of the same length; non-finite or non-positive pairs are ignored.
 ConvergenceFit convergence_order(const std::vector<double>& h, const std::vector<double>& error);
 
-// The cheapest point (least cpu_seconds; ties: fewer steps) among `records` with status ok and
-// |inversion_time_rel_error| < threshold; -1 when none.
+// The cheapest point (least cpu_seconds; ties: fewer steps) among `records` that is_safe under
+// `c` (the one criterion of "safe", sweep_record.h); -1 when none.
+long long cheapest_safe(const std::vector<SweepRecord>& records, const SearchCriterion& c);
+// The criterion the sweep page's "setting to use" applies on a scene: where the reference inverts,
+// the inversion within `tolerance`; where it does not, the reference's regime.
+SearchCriterion setting_criterion(bool reference_inverts, double tolerance);
+// cheapest_safe with the inversion within `threshold` (|inversion_time_rel_error| <= threshold,
+// the run finished and classed ok); -1 when none.
 long long cheapest_below(const std::vector<SweepRecord>& records, double threshold);
 // The cheapest point with status ok and |inversion_time_rel_error| <= error; -1 when none.
 long long cheapest_at_least_as_accurate(const std::vector<SweepRecord>& records, double error);
 
 // One setup's points: walking from the finest setting to softer ones, the softest reached before
-// the first point out of the reference's regime; -1 when even the finest disagrees or there are
+// the first point that is not safe in the reference's regime (is_safe, "regime"); -1 when even the finest disagrees or there are
 // no points. Indices into `records`.
 long long softest_agreeing(const std::vector<SweepRecord>& records);
 // Where the reference does not invert and a time-step ladder's runs leave its regime (they

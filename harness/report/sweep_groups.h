@@ -34,9 +34,6 @@ inline std::string short_setting(const SweepRecord& r) {
   return last_part(r.ladder_key) + " = " + ladder_text(r) +
          (r.grid_key.empty() ? "" : ", " + last_part(r.grid_key) + " = " + grid_text(r));
 }
-// A point a setting may be recommended from: the stability map does not class it unphysical or
-// diverged (a run that ends in time with a broken conservation law is no setting to use).
-inline bool recommendable(const SweepRecord& r) { return r.run_class != "unphysical" && r.run_class != "diverged"; }
 
 // The records of one scene, grouped by setup in sweep order.
 struct SetupGroup {
@@ -75,11 +72,11 @@ std::vector<std::string> render_sweep_charts(const std::filesystem::path& dir, c
                                              std::string& note);
 
 // The finding the sweep page opens with: one sentence per engine, from the records alone. Its
-// regime against the reference's (points in it, of its points, per scene), its inversion-time
-// error where both invert, and the setting to use on each scene: the cheapest point below 1 %
-// inversion-time error (10 % when none reaches 1 %) where the reference inverts, the cheapest
-// finished point in the reference's regime where it does not; never a point the stability map
-// classes unphysical or diverged (recommendable).
+// points that are safe in the reference's regime (is_safe, "regime"; of its points, per scene),
+// its inversion-time error where both invert, and the setting to use on each scene: the cheapest
+// point safe with the inversion within 1 % (10 % when none is) where the reference inverts, the
+// cheapest safe in the reference's regime where it does not. "Safe" is the one criterion
+// (sweep_record.h) the boundary search and the gates use.
 std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes);
 
 }  // namespace tippe::sweep_report_detail

@@ -107,15 +107,15 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
     all.insert(all.end(), u.points.begin(), u.points.end());
     if (u.engine == reference_engine().name)
       for (const SweepRecord& r : u.points)
-        if (recommendable(r)) analytic.push_back(r);
+        if (r.run_class != "unphysical" && r.run_class != "diverged") analytic.push_back(r);
     if (std::find(engines.begin(), engines.end(), u.engine) == engines.end()) engines.push_back(u.engine);
   }
 
   if (s.reference_inversion) {
     doc.heading(3, "Cheapest setting of each engine by inversion-time error");
-    doc.para("For each engine (over all its setups) the point with the least CPU time whose run finished "
-             "(status ok) with |relative inversion-time error| below the bound; points the stability map classes "
-             "unphysical or diverged are left out, whatever their error. \"Analytic at least as "
+    doc.para("For each engine (over all its setups) the point with the least CPU time that is safe with the "
+             "inversion within the bound (the one criterion of the page's opening: finished, classed ok by the "
+             "stability map, |relative inversion-time error| <= the bound). \"Analytic at least as "
              "accurate\": the cheapest point of the analytic model's own ladders with an error no larger than "
              "this point's; the ratio is this point's CPU time over that one's.");
     Table t{{"engine", "error below", "setup", "setting", "inversion error", "CPU s", "steps",
@@ -124,7 +124,7 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
     for (const std::string& e : engines) {
       std::vector<SweepRecord> mine;
       for (const SweepRecord& r : all)
-        if (r.engine == e && recommendable(r)) mine.push_back(r);
+        if (r.engine == e) mine.push_back(r);
       for (double bound : {0.1, 0.01, 0.001}) {
         const long long i = cheapest_below(mine, bound);
         if (i < 0) {
@@ -188,9 +188,10 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
   doc.heading(3, s.reference_inversion ? "Regime: does it still invert?" : "Regime: does it still roll?");
   doc.para(std::string("The reference ") + (s.reference_inversion ? "inverts" : "does not invert") +
                      ". For each setup, the softest setting (largest time step or tolerance, fewest iterations) "
-                     "reached from the finest one before the first point whose regime differs from the "
-                     "reference's" +
+                     "reached from the finest one before the first point that is not safe in the reference's "
+                     "regime (the page's one criterion: its regime differs" +
                      (s.reference_inversion ? " (no inversion)" : " (it inverts, or the run ends early)") +
+                     ", or the stability map classes it other than ok)" +
                      ". Every verdict here holds up to the runs' horizon, t = " + fmt("%.4g", s.duration) +
                      (s.reference_inversion
                           ? "."
@@ -198,7 +199,7 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
                             "goes away as the step shrinks (the finest runs roll), only moves later (every finished "
                             "run inverts, later at a smaller step), or converges (the two finest runs invert within "
                             "1 % of each other: the engine's model, not its step)."));
-  Table reg{{"setup", "engine", "softest setting in the reference's regime", "points out of the regime",
+  Table reg{{"setup", "engine", "softest safe setting in the reference's regime", "points not safe",
              "as the step shrinks"},
             {}};
   for (const SetupGroup& u : s.setups)
@@ -207,11 +208,13 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
       const bool choices = std::any_of(l.points.begin(), l.points.end(),
                                        [](const SweepRecord& r) { return !std::isfinite(r.ladder_value); });
       std::string out;
+      const SearchCriterion regime = setting_criterion(false, 0);
       for (const SweepRecord& r : l.points)
-        if (!agrees_with_reference_regime(r)) {
+        if (!is_safe(regime, r)) {
           std::string what = r.inversion_time
                                  ? "inverts at " + fmt("%.4g", *r.inversion_time)
                                  : (r.status == "ok" ? "no inversion" : r.status + " at " + fmt("%.4g", r.status_time));
+          if (r.status == "ok" && r.run_class != "ok") what += ", classed " + r.run_class;
           out += (out.empty() ? "" : "; ") + ladder_text(r) + ": " + what;
         }
       reg.rows.push_back({l.title, u.engine,
@@ -434,9 +437,12 @@ Document build_doc(const std::vector<SweepRecord>& records, const std::vector<st
   const std::vector<std::string> verdicts = sweep_verdicts(scenes);
   for (const std::string& v : verdicts) doc.para(v, "verdict");
   if (!verdicts.empty())
-    doc.para("A point counts as in the reference's regime when it inverts where the reference does and finishes "
-             "without inverting where it does not; points the stability map classes unphysical or diverged never "
-             "count, nor are they ever the setting to use.",
+    doc.para("Safe, the one criterion of this page's sentences, its tables, its boundary searches and the gates: "
+             "the run finished (status ok), the stability map classes it ok, and it is in the reference's regime "
+             "(it inverts where the reference does and finishes without inverting where it does not, judged inside "
+             "the reference's converged window); where the reference inverts, the setting to use also has its "
+             "inversion time within 1 % (10 % when no point is). Points the stability map classes "
+             "unphysical or diverged never count, nor are they ever the setting to use.",
              "note");
   size_t points = 0;
   std::set<std::string> setups, commits;

@@ -55,9 +55,13 @@ std::vector<ReportPart> boundary_report(const std::vector<SweepRecord>& records)
       "bisects each crossing in log10 until the bracket is narrower than its resolution. The boundary is the last "
       "safe value walking from the finest setting towards softer ones (for a time step: the largest safe step); "
       "a criterion that changes more than once on the coarse grid is marked not monotonic, every crossing is "
-      "listed, and the boundary given is the first from the fine end. \"regime\": the run inverts when the "
-      "reference does and finishes without inverting when it does not; \"METRIC <= BOUND\": the run finished "
-      "(status ok) and |METRIC| <= BOUND. A change of the criterion between two coarse values that goes and "
+      "listed, and the boundary given is the first from the fine end. A point is safe (the one criterion of "
+      "the page's opening sentence, its regime table and the gates) when the run finished (status ok), the "
+      "stability map classes it ok (no divergence, no energy gain in a dissipative scene, no Jellett drift where "
+      "J is conserved), and every term of the criterion holds: \"regime\": it inverts when the reference does "
+      "and does not when it does not, within the reference's converged window; \"inversion within TOL\": "
+      "where the reference inverts, |relative inversion-time error| <= TOL; \"METRIC <= BOUND\": |METRIC| <= "
+      "BOUND. A change of the criterion between two coarse values that goes and "
       "comes back within one coarse interval is not seen.";
   out.push_back(intro);
 

@@ -26,17 +26,16 @@ std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes) {
     double lo = kInfinity, hi = -kInfinity;
     std::vector<std::string> per_scene, use;
     for (const SceneGroup& s : scenes) {
-      std::vector<SweepRecord> mine, usable_points;
+      std::vector<SweepRecord> mine;
       for (const SetupGroup& u : s.setups)
-        if (u.engine == e)
-          for (const SweepRecord& r : u.points) {
-            mine.push_back(r);
-            if (recommendable(r)) usable_points.push_back(r);
-          }
+        if (u.engine == e) mine.insert(mine.end(), u.points.begin(), u.points.end());
       if (mine.empty()) continue;
+      // Every count and choice below is the one criterion of "safe" (is_safe), the boundary
+      // search's and the gates': the same records can give no other answer here.
+      const SearchCriterion regime = setting_criterion(false, 0);
       size_t a = 0;
       for (const SweepRecord& r : mine) {
-        a += agrees_with_reference_regime(r) && recommendable(r);
+        a += is_safe(regime, r);
         if (r.metrics.inversion_event == "both" && r.metrics.inversion_time_rel_error &&
             std::isfinite(*r.metrics.inversion_time_rel_error)) {
           lo = std::min(lo, std::abs(*r.metrics.inversion_time_rel_error));
@@ -51,27 +50,24 @@ std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes) {
                       " CPU s)");
       };
       if (s.reference_inversion) {
-        long long i = cheapest_below(usable_points, 0.01);
+        long long i = cheapest_safe(mine, setting_criterion(true, 0.01));
         if (i >= 0) {
-          const SweepRecord& r = usable_points[static_cast<size_t>(i)];
-          pick(r, "the cheapest below 1 %: " + pct(std::abs(*r.metrics.inversion_time_rel_error)));
-        } else if ((i = cheapest_below(usable_points, 0.1)) >= 0) {
-          const SweepRecord& r = usable_points[static_cast<size_t>(i)];
-          pick(r, "none reaches 1 %; the cheapest below 10 %: " + pct(std::abs(*r.metrics.inversion_time_rel_error)));
+          const SweepRecord& r = mine[static_cast<size_t>(i)];
+          pick(r, "the cheapest safe within 1 %: " + pct(std::abs(*r.metrics.inversion_time_rel_error)));
+        } else if ((i = cheapest_safe(mine, setting_criterion(true, 0.1))) >= 0) {
+          const SweepRecord& r = mine[static_cast<size_t>(i)];
+          pick(r, "none safe within 1 %; the cheapest safe within 10 %: " +
+                      pct(std::abs(*r.metrics.inversion_time_rel_error)));
         } else {
-          use.push_back("on " + s.name + " none (no point within 10 % of the reference's inversion time)");
+          use.push_back("on " + s.name + " none (no safe point within 10 % of the reference's inversion time)");
         }
       } else {
-        const SweepRecord* best = nullptr;
-        for (const SweepRecord& r : usable_points)
-          if (r.status == "ok" && agrees_with_reference_regime(r) && std::isfinite(r.cpu_seconds) &&
-              (!best || r.cpu_seconds < best->cpu_seconds))
-            best = &r;
-        if (best) pick(*best, "the cheapest in the reference's regime");
-        else use.push_back("on " + s.name + " none (no finished point in the reference's regime)");
+        const long long i = cheapest_safe(mine, regime);
+        if (i >= 0) pick(mine[static_cast<size_t>(i)], "the cheapest safe: in the reference's regime");
+        else use.push_back("on " + s.name + " none (no safe point in the reference's regime)");
       }
     }
-    std::string t = e + ": in the reference's regime at " + std::to_string(agree) + " of " + std::to_string(total) +
+    std::string t = e + ": safe in the reference's regime at " + std::to_string(agree) + " of " + std::to_string(total) +
                     " points (" + join_list(per_scene, ", ") + "); ";
     t += lo <= hi ? "inversion-time error " + (lo == hi ? pct(lo) : pct(lo) + " to " + pct(hi)) + " where both invert"
                   : "no point where both invert";

@@ -318,8 +318,10 @@ std::vector<SearchBoundary> search_boundaries(const std::vector<SweepRecord>& re
       return criterion_passes(crit, *it->second);
     });
     const SearchReplay& rp = b.replay;
-    const bool about_inversion = !crit.regime && crit.bound.metric.rfind("inversion_time", 0) == 0;
-    const bool about_stem = !crit.regime && crit.bound.metric.rfind("stem_contact_time", 0) == 0;
+    const Threshold* only = crit.only_bound();
+    const bool about_inversion = (only && only->metric.rfind("inversion_time", 0) == 0) ||
+                                 (!crit.regime && crit.inversion && crit.bounds.empty());
+    const bool about_stem = only && only->metric.rfind("stem_contact_time", 0) == 0;
     const bool larger = larger_is_softer(b.key);
     if (about_inversion && std::none_of(rs.begin(), rs.end(), [](const SweepRecord* r) { return r->reference_inversion_time.has_value(); })) {
       b.status = "not_applicable";

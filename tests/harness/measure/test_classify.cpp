@@ -113,6 +113,63 @@ TEST(Classify, EnergyRiseInDissipativeSceneIsUnphysicalAtTheFirstRise) {
   EXPECT_NE(c.reason.find("energy rose"), std::string::npos) << c.reason;
 }
 
+// A trajectory of n samples every dt with the energy e(t), on the ball, J constant.
+Trajectory energy_trajectory(int n, double dt, double (*e)(double)) {
+  Trajectory tr;
+  for (int k = 0; k < n; ++k) {
+    Observation o;
+    o.state.t = dt * k;
+    o.energy = e(o.state.t);
+    o.jellett = -2.0;
+    o.surface = Surface::Ball;
+    o.normal_force = 1.0;
+    tr.append(o);
+  }
+  return tr;
+}
+
+TEST(Classify, SmallRisesThatAddUpAreAGain) {
+  // Rises of 0.5e-6 E0 between samples, each below the tolerance: the rule on neighbouring
+  // samples never saw them; their net rise passes 1e-6 E0 at the third.
+  Samples x(11);
+  for (int k = 0; k < 11; ++k) x.energy[static_cast<size_t>(k)] = 10.0 * (1 + 0.5e-6 * k);
+  const RunClass c = classify(viscous_scene(), ok_run(), x);
+  EXPECT_EQ(c.kind, RunClassKind::Unphysical) << c.reason;
+  EXPECT_DOUBLE_EQ(c.time, x.t[3]);
+  EXPECT_NE(c.reason.find("net rise"), std::string::npos) << c.reason;
+}
+
+TEST(Classify, TheEnergyRuleDoesNotDependOnTheSampleInterval) {
+  // A steady injection of 1e-4 E0 per unit time, sampled every 0.1 and every 0.001: between two
+  // samples 1e-5 E0 (above the tolerance) and 1e-7 E0 (below it). Both are the same run, and
+  // both are unphysical, dated where the net rise passes 1e-6 E0 (t = 0.01) to within a sample.
+  const auto drift = [](double t) { return 10.0 * (1 + 1e-4 * t); };
+  const Trajectory coarse = energy_trajectory(11, 0.1, drift), fine = energy_trajectory(1001, 0.001, drift);
+  const EnergyGains gc = energy_gains(coarse), gf = energy_gains(fine);
+  EXPECT_EQ(gc.events, 1);
+  EXPECT_EQ(gf.events, 1);
+  EXPECT_NEAR(gc.max_rise, 1e-4, 1e-12);
+  EXPECT_NEAR(gf.max_rise, 1e-4, 1e-12) << "the same net rise whatever the sampling";
+  EXPECT_NEAR(gf.time, 0.01, 0.001 + 1e-12);
+  EXPECT_NEAR(gc.time, 0.1, 1e-12) << "the coarse samples date it at their first";
+  for (const Trajectory* tr : {&coarse, &fine})
+    EXPECT_EQ(classify_run(viscous_scene(), ok_run(), nullptr, *tr).kind, RunClassKind::Unphysical);
+}
+
+TEST(Classify, JitterBelowTheToleranceNeverAddsUp) {
+  // 10000 samples of a falling energy with +-0.4e-6 E0 of jitter: many rises between samples,
+  // none a net rise above the tolerance, however long the run.
+  const auto jitter = [](double t) {
+    const long k = std::lround(t / 0.001);
+    return 10.0 * (1 - 1e-9 * static_cast<double>(k) + (k % 2 ? 0.4e-6 : -0.4e-6));
+  };
+  const Trajectory tr = energy_trajectory(10000, 0.001, jitter);
+  const EnergyGains g = energy_gains(tr);
+  EXPECT_EQ(g.events, 0);
+  EXPECT_LT(g.max_rise, kEnergyGainTolerance);
+  expect_ok(classify_run(viscous_scene(), ok_run(), nullptr, tr));
+}
+
 TEST(Classify, EnergyRiseWhereEnergyMayRiseIsOk) {
   Samples x(11);
   x.energy[7] = x.energy[6] + 1e-3 * 10.0;
@@ -290,7 +347,7 @@ TEST(Classify, WithoutTrajectoryTheSummariesDecide) {
   RunClass c = classify_run(viscous_scene(), ok_run(), &m, none);
   EXPECT_EQ(c.kind, RunClassKind::Unphysical);
   EXPECT_TRUE(std::isnan(c.time));
-  EXPECT_NE(c.reason.find("3 energy rises"), std::string::npos) << c.reason;
+  EXPECT_NE(c.reason.find("3 net energy rises"), std::string::npos) << c.reason;
 
   RunRecord r = ok_run();
   r.jellett_drift_ball = 5e-4;

@@ -62,7 +62,7 @@ std::vector<SweepRecord> fixture() {
 }
 
 std::string verdict_line(const std::string& md, const std::string& engine) {
-  const size_t at = md.find("\n" + engine + ": in the reference's regime");
+  const size_t at = md.find("\n" + engine + ": safe in the reference's regime");
   if (at == std::string::npos) return "";
   return md.substr(at + 1, md.find('\n', at + 1) - at - 1);
 }
@@ -73,9 +73,9 @@ TEST(SweepVerdict, RegimeErrorAndTheSettingToUse) {
   const std::string md = render_sweep_markdown(fixture());
   const std::string v = verdict_line(md, "ode");
   EXPECT_EQ(v,
-            "ode: in the reference's regime at 5 of 6 points (inverting 3/3, rolling 2/3); inversion-time error 0.01 % to 5 % where both invert; setting to use: on inverting ode "
-            "timestep = 0.001 (the cheapest below 1 %: 0.5 %, 1 CPU s); on rolling ode timestep = 0.001 (the cheapest "
-            "in the reference's regime, 1 CPU s).")
+            "ode: safe in the reference's regime at 5 of 6 points (inverting 3/3, rolling 2/3); inversion-time error 0.01 % to 5 % where both invert; setting to use: on inverting ode "
+            "timestep = 0.001 (the cheapest safe within 1 %: 0.5 %, 1 CPU s); on rolling ode timestep = 0.001 (the cheapest "
+            "safe: in the reference's regime, 1 CPU s).")
       << md;
   // It opens the page: before the first table and the first section.
   EXPECT_LT(md.find(v), md.find("| "));
@@ -90,16 +90,16 @@ TEST(SweepVerdict, AnUnphysicalOrDivergedPointIsNeverRecommended) {
   recs[4].status = "ok";
   const std::string md = render_sweep_markdown(recs);
   const std::string v = verdict_line(md, "ode");
-  EXPECT_NE(v.find("on inverting ode timestep = 0.0001 (the cheapest below 1 %: 0.01 %, 10 CPU s)"), std::string::npos)
+  EXPECT_NE(v.find("on inverting ode timestep = 0.0001 (the cheapest safe within 1 %: 0.01 %, 10 CPU s)"), std::string::npos)
       << v;
-  EXPECT_NE(v.find("on rolling ode timestep = 0.0001 (the cheapest in the reference's regime, 10 CPU s)"),
+  EXPECT_NE(v.find("on rolling ode timestep = 0.0001 (the cheapest safe: in the reference's regime, 10 CPU s)"),
             std::string::npos)
       << v;
   EXPECT_NE(v.find("at 3 of 6 points"), std::string::npos) << v;
   // The recommended-settings table: the 1 % row names 1e-4, not the unphysical 1e-3.
   EXPECT_NE(md.find("| ode | 1 % | ode | engines.ode.timestep = 0.0001 |"), std::string::npos) << md;
   EXPECT_EQ(md.find("| ode | 1 % | ode | engines.ode.timestep = 0.001 |"), std::string::npos) << md;
-  EXPECT_NE(md.find("left out, whatever their error"), std::string::npos);
+  EXPECT_NE(md.find("classed ok by the stability map"), std::string::npos);
   EXPECT_NE(md.find("unphysical or diverged never count, nor are they ever the setting to use"), std::string::npos);
 }
 
@@ -120,7 +120,7 @@ TEST(SweepVerdict, HtmlPageColoursTheClassAndLinksTheRecords) {
   recs[2].run_class = "diverged";
   write_sweep_report(dir.path().string(), recs, false);
   const std::string html = slurp(dir.path() / "index.html");
-  EXPECT_NE(html.find("<p class=\"verdict\">ode: in the reference"), std::string::npos);
+  EXPECT_NE(html.find("<p class=\"verdict\">ode: safe in the reference"), std::string::npos);
   EXPECT_NE(html.find("<td class=\"c-diverged\">diverged</td>"), std::string::npos);
   EXPECT_NE(html.find("<a href=\"records.jsonl\">records.jsonl</a>"), std::string::npos);
   EXPECT_NE(html.find("<a href=\"../index.html\">all reports</a>"), std::string::npos);

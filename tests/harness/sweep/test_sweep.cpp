@@ -297,7 +297,8 @@ TEST(SweepAnalysis, CheapestSettingBelowEachBound) {
   EXPECT_EQ(cheapest_below(b, 0.1), 0);
   EXPECT_EQ(cheapest_below(b, 0.01), 2) << "the diverged point is skipped";
   EXPECT_EQ(cheapest_below(b, 0.001), 2);
-  EXPECT_EQ(cheapest_below(b, 0.0009), -1) << "the bound is strict";
+  EXPECT_EQ(cheapest_below(b, 0.0009), 2) << "the bound is inclusive, as every criterion's |METRIC| <= BOUND";
+  EXPECT_EQ(cheapest_below(b, 0.00089), -1);
 
   // The analytic side: the cheapest point at least as accurate.
   std::vector<SweepRecord> an = {point("analytic", "bs", 1e-4, 0.002, 1e-5), point("analytic", "bs", 1e-8, 0.004, 1e-9),
