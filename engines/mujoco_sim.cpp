@@ -479,6 +479,7 @@ const EngineInfo& mujoco_engine_info() {
     e.make = make_mujoco_simulator;
     e.validate = validate_mujoco_settings;
     e.default_settings = [] { return list_settings(MujocoSettings{}); };
+    e.describe_settings = [] { return describe_settings(MujocoSettings{}); };
     e.version = std::string("mujoco ") + mj_versionString();
     e.colour = "#009E73";  // Okabe-Ito bluish green
     return e;
