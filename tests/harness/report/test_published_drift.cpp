@@ -83,7 +83,8 @@ TEST_F(ComparisonDrift, TheSameRecordPasses) {
 }
 
 TEST_F(ComparisonDrift, EachEditedFieldIsCaught) {
-  const auto [e, k] = first_event(record_);
+  // Plain variables, not a structured binding: the lambdas below capture them (C++17).
+  const size_t e = first_event(record_).first, k = first_event(record_).second;
   ASSERT_FALSE(record_.at("engines")[e].at("summary").at("events").empty()) << "no engine of " << kScene << " has an event";
   const std::string engine = record_.at("engines")[e].at("engine");
   // Status.
@@ -152,7 +153,7 @@ TEST(PublishedDrift, TheCheckPassesOnThePublishedRecordAndFailsOnAnEditedCopy) {
   ASSERT_EQ(r.exit.code, 0) << "the code no longer gives reports/" << kScene << " (republish):\n" << r.out;
 
   json c = read_json(copy / kScene / "comparison.json");
-  const auto [e, k] = first_event(c);
+  const size_t e = first_event(c).first, k = first_event(c).second;
   json& t = c["engines"][e]["summary"]["events"][k]["time"];
   t = t.get<double>() + 1e-3;
   spit(copy / kScene / "comparison.json", c.dump(2));
