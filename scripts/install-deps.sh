@@ -4,12 +4,12 @@ set -euo pipefail
 pkgs=(cmake g++ make pkg-config libeigen3-dev libbullet-dev libode-dev libmujoco-dev libqhull-dev
       libgtest-dev libgmock-dev libboost-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
       libbenchmark-dev gnuplot-nox
-      python3-dev python3-pybind11 python3-numpy  # the Python module tippe (README, "Use it as a library")
+      python3-dev python3-pybind11 python3-numpy  # the Python module tippe (docs/library.md)
       python3-jsonschema  # the records against schemas/ (Library.RecordsMatchSchemas)
       libdart-dev libdart-external-ikfast-dev  # DART 6.12 (engines/dart/dart_sim.cpp); dart/dart.hpp needs ikfast's headers
       libsimbody-dev  # Simbody 3.7 (engines/simbody/): the error-controlled, compliant-contact engine
       chromium  # headless, for the check of every published page (tests/harness/report/test_published_pages.cpp)
-      libopenmpi-dev openmpi-bin  # MPI sweeps: mpirun -np N tippe sweep (README, "Running a sweep on a cluster")
+      libopenmpi-dev openmpi-bin  # MPI sweeps: mpirun -np N tippe sweep (docs/cluster.md)
       clang libclang-rt-14-dev)  # clang 14 + its sanitizer and libFuzzer runtimes: scripts/sanitize.sh, scripts/fuzz.sh
 missing=()
 for p in "${pkgs[@]}"; do

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Install, build and run the whole test suite (CTest over GoogleTest).
+# Install, build everything (the test programs, benchmarks and the Python module besides `tippe`) and run the whole test suite (CTest over GoogleTest).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh

@@ -32,6 +32,8 @@ struct EngineInfo {
   std::function<void(const Scene&)> validate;
   // The settings struct's defaults as key=value (what `tippe info` lists).
   std::function<SettingsList()> default_settings;
+  // Every setting's key, type, default and accepted values (docs/engines.md, `tippe info --markdown`).
+  std::function<std::vector<SettingDoc>()> describe_settings;
   // The reference only: writes its [engines.NAME] table into scene.run (the values the
   // reference and the harness read), so that [run]'s older keys and the table agree.
   std::function<void(Scene&)> adopt;
@@ -55,6 +57,7 @@ void set_settings_struct(EngineInfo& info, std::function<void(const Settings&, c
     if (check) check(s, scene);
   };
   info.default_settings = [] { return list_settings(Settings{}); };
+  info.describe_settings = [] { return describe_settings(Settings{}); };
 }
 
 // One registry entry from a settings struct with `visit` (validate and default_settings as

@@ -147,6 +147,46 @@ class SettingsLister {
   static std::string num(double v) { return round_trip_text(v); }
 };
 
+// One setting as the documentation lists it (docs/engines.md, `tippe info --markdown`): its key,
+// its type, its default and the values it accepts, all from the settings struct's `visit`.
+struct SettingDoc {
+  std::string key, type, default_value, allowed;
+};
+class SettingsDescriber {
+ public:
+  void operator()(const char* key, double& field, double lo, double hi) {
+    put(key, "number", round_trip_text(field), "[" + round_trip_text(lo) + ", " + round_trip_text(hi) + "]");
+  }
+  void operator()(const char* key, int& field, int lo, int hi) {
+    put(key, "integer", std::to_string(field), "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  void operator()(const char* key, bool& field) { put(key, "boolean", field ? "true" : "false", "true, false"); }
+  void operator()(const char* key, std::string& field, const std::vector<std::string>& choices) {
+    std::string list;
+    for (const auto& c : choices) list += (list.empty() ? "\"" : ", \"") + c + "\"";
+    put(key, "string", "\"" + field + "\"", list);
+  }
+  void operator()(const char* key, std::string& field) { put(key, "string", "\"" + field + "\"", "any string"); }
+  void operator()(const char* key, std::vector<double>& field, size_t n) {
+    std::string s = "[";
+    for (size_t i = 0; i < field.size(); ++i) s += (i ? ", " : "") + round_trip_text(field[i]);
+    put(key, "array", s + "]", std::to_string(n) + " finite numbers");
+  }
+  std::vector<SettingDoc> list;
+
+ private:
+  void put(const char* key, std::string type, std::string value, std::string allowed) {
+    list.push_back({key, std::move(type), std::move(value), std::move(allowed)});
+  }
+};
+
+template <class Settings>
+std::vector<SettingDoc> describe_settings(Settings s) {
+  SettingsDescriber d;
+  s.visit(d);
+  return d.list;
+}
+
 template <class Settings>
 Settings read_settings(const std::string& engine, const Scene& scene) {
   Settings s;

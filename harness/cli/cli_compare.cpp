@@ -10,7 +10,9 @@
 #include "cli/cli.h"
 #include "measure/compare.h"
 #include "report/report.h"
+#include "io/files.h"
 #include "io/scene_io.h"
+#include "records/sweep_record.h"
 
 namespace tippe::cli {
 
@@ -98,6 +100,42 @@ int index_verdict(const std::string& dir) {
   return 0;
 }
 
+// The published index from DIR/*/comparison.json and DIR/*/records.jsonl (with sweep.json): DIR/index.html
+// and DIR/README.md, each written whole (the records are only read).
+int write_index(const std::string& dir) {
+  IndexInput input;
+  std::vector<fs::path> subdirs;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_directory()) subdirs.push_back(entry.path());
+  if (ec) throw UsageError(dir + ": cannot list (" + ec.message() + ")");
+  std::sort(subdirs.begin(), subdirs.end());
+  for (const fs::path& p : subdirs) {
+    const std::string name = p.filename().string();
+    if (fs::exists(p / "comparison.json")) {
+      input.comparisons.push_back({name, read_comparison(p / "comparison.json")});
+    } else if (fs::exists(p / "records.jsonl") && fs::exists(p / "sweep.json")) {
+      IndexSweep sw;
+      sw.dir = name;
+      try {
+        const nlohmann::json meta = nlohmann::json::parse(read_file_text((p / "sweep.json").string(), kMaxInputFileBytes));
+        if (meta.contains("description") && meta.at("description").is_string()) sw.description = meta.at("description");
+        sw.records = read_records((p / "records.jsonl").string()).records;
+      } catch (const std::exception& e) {
+        throw UsageError((p / "records.jsonl").string() + " or sweep.json: " + e.what());
+      }
+      input.sweeps.push_back(std::move(sw));
+    }
+  }
+  if (input.comparisons.empty()) throw UsageError(dir + ": no SCENE/comparison.json in it");
+  const std::string html = render_document_html(index_document(input, "index.html"));
+  const std::string md = render_document_markdown(index_document(input, "report.md"));
+  write_file_atomic((fs::path(dir) / "index.html").string(), html);
+  write_file_atomic((fs::path(dir) / "README.md").string(), md);
+  std::printf("index: %s\n", (fs::path(dir) / "index.html").string().c_str());
+  return 0;
+}
+
 int report(const std::string& dir, bool no_plots, bool summary_line) {
   const nlohmann::json j = read_comparison(fs::path(dir) / "comparison.json");
   if (summary_line) {
@@ -141,7 +179,7 @@ Command setup_compare(CLI::App& app) {
 Command setup_report(CLI::App& app) {
   auto dir = std::make_shared<std::string>();
   auto no_plots = std::make_shared<bool>(false), summary_line = std::make_shared<bool>(false),
-       index = std::make_shared<bool>(false);
+       index = std::make_shared<bool>(false), write = std::make_shared<bool>(false);
   CLI::App* sub = app.add_subcommand(
       "report", "Regenerate report.md, index.html and plots of a `tippe compare` directory from its records");
   sub->add_option("dir", *dir, "Directory written by tippe compare")->required();
@@ -150,8 +188,12 @@ Command setup_report(CLI::App& app) {
   sub->add_flag("--index-verdict", *index,
                 "DIR holds one comparison directory per scene: print one verdict sentence per engine over all of "
                 "them (writes nothing)");
-  return {sub, [dir, no_plots, summary_line, index] {
-            return *index ? index_verdict(*dir) : report(*dir, *no_plots, *summary_line);
+  sub->add_flag("--index", *write,
+                "DIR holds one comparison directory per scene and sweep directories: write DIR/index.html and "
+                "DIR/README.md (the verdict matrix, the per-engine sentences, the scenes and the sweeps) from their "
+                "records alone");
+  return {sub, [dir, no_plots, summary_line, index, write] {
+            return *write ? write_index(*dir) : *index ? index_verdict(*dir) : report(*dir, *no_plots, *summary_line);
           }};
 }
 

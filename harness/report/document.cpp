@@ -146,7 +146,7 @@ std::string render_document_markdown(const Document& doc) {
         os << "\n";
         for (const auto& row : t.rows) {
           os << "|";
-          for (const auto& c : row) os << " " << md_cell(c.text) << " |";
+          for (const auto& c : row) os << " " << (c.href.empty() ? md_cell(c.text) : "[" + md_cell(c.text) + "](" + c.href + ")") << " |";
           os << "\n";
         }
         os << "\n";
@@ -174,6 +174,9 @@ td.good, th.good { background: #c8ecc8; } td.warn, th.warn { background: #fde5a6
 td.c-ok { background: #c8e6c9; } td.c-regime { background: #fff59d; }
 td.c-unphysical { background: #ffcc80; } td.c-clamped { background: #ce93d8; }
 td.c-diverged { background: #ef9a9a; } td.c-failed { background: #bdbdbd; } td.c-contact_lost { background: #90caf9; }
+td.v-1pct { background: #a8dba8; } td.v-regime { background: #d4eed4; } td.v-10pct { background: #fde5a6; }
+td.v-beyond { background: #ffb870; } td.v-wrong { background: #f08c8c; } td.v-failed { background: #bdbdbd; }
+table.matrix td { text-align: left; } table.matrix td a { color: #111; }
 figure { margin: 1em 0; } figure img { max-width: 100%; border: 1px solid #ddd; }
 figcaption { font-size: 0.9em; color: #444; }
 details { margin: 0.4em 0; } summary { cursor: pointer; font-weight: bold; }
@@ -206,8 +209,10 @@ std::string html_table(const DocTable& t) {
     s += "<tr>";
     for (size_t i = 0; i < row.size(); ++i) {
       const std::string tag = t.row_headers && i == 0 ? "th" : "td";
-      s += "<" + tag + (row[i].css.empty() ? std::string() : " class=\"" + markup_escape(row[i].css) + "\"") + ">" +
-           markup_escape(row[i].text) + "</" + tag + ">";
+      const std::string text = row[i].href.empty() ? markup_escape(row[i].text)
+                                                   : "<a href=\"" + markup_escape(row[i].href) + "\">" + markup_escape(row[i].text) + "</a>";
+      s += "<" + tag + (row[i].css.empty() ? std::string() : " class=\"" + markup_escape(row[i].css) + "\"") + ">" + text +
+           "</" + tag + ">";
     }
     s += "</tr>\n";
   }

@@ -8,13 +8,15 @@
 
 namespace tippe {
 
-// A table cell: its text and an optional CSS class (the page's colours: "good", "warn", "bad",
-// the stability classes "c-ok", "c-regime", ... ); Markdown shows the text alone.
+// A table cell: its text, an optional CSS class (the page's colours: "good", "warn", "bad", the
+// stability classes "c-ok", "c-regime", ..., the verdict classes "v-1pct", ..., "v-failed") and an
+// optional link (relative to the page) the text leads to; Markdown shows the text (as a link).
 struct DocCell {
   std::string text;
   std::string css;
+  std::string href;
   DocCell() = default;
-  DocCell(std::string t, std::string c = "") : text(std::move(t)), css(std::move(c)) {}
+  DocCell(std::string t, std::string c = "", std::string h = "") : text(std::move(t)), css(std::move(c)), href(std::move(h)) {}
   DocCell(const char* t) : text(t) {}
 };
 

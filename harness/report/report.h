@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "records/sweep_record.h"
 #include "report/document.h"
 
 namespace tippe {
@@ -22,8 +23,37 @@ namespace tippe {
 std::vector<std::string> verdict_sentences(const nlohmann::json& comparison);
 
 // The index of many comparisons opens with one sentence per engine over all of them: on how
-// many scenes it is in the reference's regime (and which not), its inversion-time errors.
+// many scenes it is in the reference's regime (and on how many not), its inversion-time errors.
 std::vector<std::string> index_verdicts(const std::vector<nlohmann::json>& comparisons);
+
+// One engine's verdict on one scene, a cell of the index's matrix: its kind ("1pct", "10pct",
+// "beyond": the reference's regime, both invert, and the inversion-time error's size; "regime":
+// neither inverts; "wrong": the wrong regime; "failed": the run ended early without reaching the
+// reference's regime) and its text (the signed inversion-time error, or what each side does).
+struct VerdictCell {
+  std::string kind, text;
+};
+VerdictCell verdict_cell(const nlohmann::json& comparison, const nlohmann::json& engine_entry);
+// Every kind in the order the legend lists them, and each in words.
+const std::vector<std::string>& verdict_kinds();
+std::string verdict_kind_text(const std::string& kind);
+// The name of its colour on the page ("dark green", ...), for the legend and the Markdown index.
+std::string verdict_colour_name(const std::string& kind);
+
+// The published index (reports/index.html and reports/README.md): the matrix of verdicts (scenes
+// down, engines across, in the order the records name them), the per-engine sentences, one row per
+// scene, and every sweep with the matrix of its settings to use. Made from the records alone.
+struct IndexSweep {
+  std::string dir;          // the sweep's directory, relative to the index
+  std::string description;  // its sweep.json's
+  std::vector<SweepRecord> records;  // its records.jsonl
+};
+struct IndexInput {
+  std::vector<std::pair<std::string, nlohmann::json>> comparisons;  // scene directory, comparison.json
+  std::vector<IndexSweep> sweeps;
+};
+// page: the file each scene and sweep directory is linked by ("index.html" or "report.md").
+Document index_document(const IndexInput& input, const std::string& page);
 
 // The summary table in Markdown: the reference, then one row per engine.
 std::string render_summary_table(const nlohmann::json& comparison);

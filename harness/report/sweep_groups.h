@@ -79,4 +79,18 @@ std::vector<std::string> render_sweep_charts(const std::filesystem::path& dir, c
 // (sweep_record.h) the boundary search and the gates use.
 std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes);
 
+// The setting to use of one engine on one scene, as sweep_verdicts says it: the point (none when
+// no point qualifies), how it qualified ("1pct", "10pct": its inversion-time error is below 1 %
+// or 10 %; "regime": the cheapest finished point in the reference's regime, where the reference
+// does not invert; "none") and why, in words. `found` is false when the engine has no point there.
+struct SettingToUse {
+  bool found = false;
+  std::optional<SweepRecord> point;
+  std::string tier = "none";
+  std::string why;
+};
+SettingToUse setting_to_use(const SceneGroup& s, const std::string& engine);
+// The engines of the records, in the order their setups first appear.
+std::vector<std::string> engines_of(const std::vector<SceneGroup>& scenes);
+
 }  // namespace tippe::sweep_report_detail

@@ -14,14 +14,54 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 }  // namespace
 
-// sweep_groups.h says what each sentence holds.
-std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes) {
+std::vector<std::string> engines_of(const std::vector<SceneGroup>& scenes) {
   std::vector<std::string> engines;
   for (const SceneGroup& s : scenes)
     for (const SetupGroup& u : s.setups)
       if (std::find(engines.begin(), engines.end(), u.engine) == engines.end()) engines.push_back(u.engine);
+  return engines;
+}
+
+// The one criterion of "safe" (is_safe, through cheapest_safe): the boundary search's, the gates'
+// and advise's, so the same records can give no other setting here.
+SettingToUse setting_to_use(const SceneGroup& s, const std::string& e) {
+  SettingToUse out;
+  std::vector<SweepRecord> mine;
+  for (const SetupGroup& u : s.setups)
+    if (u.engine == e) mine.insert(mine.end(), u.points.begin(), u.points.end());
+  out.found = !mine.empty();
+  if (!out.found) return out;
+  if (s.reference_inversion) {
+    long long i = cheapest_safe(mine, setting_criterion(true, 0.01));
+    if (i >= 0) {
+      out.point = mine[static_cast<size_t>(i)];
+      out.tier = "1pct";
+      out.why = "the cheapest safe within 1 %: " + pct(std::abs(*out.point->metrics.inversion_time_rel_error));
+    } else if ((i = cheapest_safe(mine, setting_criterion(true, 0.1))) >= 0) {
+      out.point = mine[static_cast<size_t>(i)];
+      out.tier = "10pct";
+      out.why = "none safe within 1 %; the cheapest safe within 10 %: " +
+                pct(std::abs(*out.point->metrics.inversion_time_rel_error));
+    } else {
+      out.why = "no safe point within 10 % of the reference's inversion time";
+    }
+  } else {
+    const long long i = cheapest_safe(mine, setting_criterion(false, 0));
+    if (i >= 0) {
+      out.point = mine[static_cast<size_t>(i)];
+      out.tier = "regime";
+      out.why = "the cheapest safe: in the reference's regime";
+    } else {
+      out.why = "no safe point in the reference's regime";
+    }
+  }
+  return out;
+}
+
+// sweep_groups.h says what each sentence holds.
+std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes) {
   std::vector<std::string> out;
-  for (const std::string& e : engines) {
+  for (const std::string& e : engines_of(scenes)) {
     size_t agree = 0, total = 0;
     double lo = kInfinity, hi = -kInfinity;
     std::vector<std::string> per_scene, use;
@@ -45,27 +85,12 @@ std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes) {
       agree += a;
       total += mine.size();
       per_scene.push_back(s.name + " " + std::to_string(a) + "/" + std::to_string(mine.size()));
-      const auto pick = [&](const SweepRecord& r, const std::string& why) {
-        use.push_back("on " + s.name + " " + r.setup + " " + short_setting(r) + " (" + why + ", " + g3(r.cpu_seconds) +
-                      " CPU s)");
-      };
-      if (s.reference_inversion) {
-        long long i = cheapest_safe(mine, setting_criterion(true, 0.01));
-        if (i >= 0) {
-          const SweepRecord& r = mine[static_cast<size_t>(i)];
-          pick(r, "the cheapest safe within 1 %: " + pct(std::abs(*r.metrics.inversion_time_rel_error)));
-        } else if ((i = cheapest_safe(mine, setting_criterion(true, 0.1))) >= 0) {
-          const SweepRecord& r = mine[static_cast<size_t>(i)];
-          pick(r, "none safe within 1 %; the cheapest safe within 10 %: " +
-                      pct(std::abs(*r.metrics.inversion_time_rel_error)));
-        } else {
-          use.push_back("on " + s.name + " none (no safe point within 10 % of the reference's inversion time)");
-        }
-      } else {
-        const long long i = cheapest_safe(mine, regime);
-        if (i >= 0) pick(mine[static_cast<size_t>(i)], "the cheapest safe: in the reference's regime");
-        else use.push_back("on " + s.name + " none (no safe point in the reference's regime)");
-      }
+      const SettingToUse u = setting_to_use(s, e);
+      if (u.point)
+        use.push_back("on " + s.name + " " + u.point->setup + " " + short_setting(*u.point) + " (" + u.why + ", " +
+                      g3(u.point->cpu_seconds) + " CPU s)");
+      else
+        use.push_back("on " + s.name + " none (" + u.why + ")");
     }
     std::string t = e + ": safe in the reference's regime at " + std::to_string(agree) + " of " + std::to_string(total) +
                     " points (" + join_list(per_scene, ", ") + "); ";

@@ -364,6 +364,14 @@ class Chromium {
     return problems_;
   }
 
+  // The value of a JavaScript expression on the page loaded last (a Promise is awaited), as JSON.
+  nlohmann::json evaluate(const std::string& expression, double timeout_seconds = 30.0) {
+    const nlohmann::json r = call("Runtime.evaluate", {{"expression", expression}, {"returnByValue", true}, {"awaitPromise", true}},
+                                  true, timeout_seconds);
+    if (r.contains("exceptionDetails")) throw std::runtime_error("evaluate: " + r.at("exceptionDetails").dump());
+    return r.at("result").value("value", nlohmann::json());
+  }
+
  private:
   using json = nlohmann::json;
 

@@ -3,9 +3,14 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cmath>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "support/page_check.h"
 #include "support/files.h"
@@ -68,6 +73,110 @@ TEST(PublishedPages, EveryPageLoadsInChromiumWithoutErrors) {
   for (const fs::path& page : pages) {
     const auto problems = browser.load(page);
     EXPECT_TRUE(problems.empty()) << page << ":" << joined(problems);
+  }
+}
+
+// The verdict an engine's record gives on a scene, as the matrix must colour it, worked out here
+// from comparison.json: in the reference's regime when it inverts as the reference does (an
+// engine that inverted and then ended early keeps its inversion); then, where both invert, the
+// size of the inversion-time error (below 1 %, below 10 %, beyond); neither inverting is the
+// regime alone; out of the regime, a run not ok ended early ("failed"), else the wrong regime.
+std::string expected_verdict(const nlohmann::json& comparison, const nlohmann::json& engine) {
+  const auto inverts = [](const nlohmann::json& s) { return s.contains("inversion_time") && s.at("inversion_time").is_number(); };
+  const nlohmann::json& ref = comparison.at("reference").at("summary");
+  const nlohmann::json& s = engine.at("summary");
+  const bool ok = s.at("status") == "ok";
+  if (inverts(s) == inverts(ref) && (ok || inverts(s))) {
+    if (!inverts(ref)) return "regime";
+    const nlohmann::json& rel = engine.at("metrics").at("inversion_time_rel_error");
+    if (!rel.is_number()) return "regime";
+    const double e = std::abs(rel.get<double>());
+    return e < 0.01 ? "1pct" : e < 0.1 ? "10pct" : "beyond";
+  }
+  return ok ? "wrong" : "failed";
+}
+
+// The colour each verdict has on the page (reports/README.md's legend): six, all different.
+const std::map<std::string, std::string> kVerdictColours = {
+    {"1pct", "rgb(168, 219, 168)"}, {"regime", "rgb(212, 238, 212)"}, {"10pct", "rgb(253, 229, 166)"},
+    {"beyond", "rgb(255, 184, 112)"}, {"wrong", "rgb(240, 140, 140)"}, {"failed", "rgb(189, 189, 189)"}};
+
+// The index's first matrix as the browser shows it: the header's engines, and per row the scene
+// and, per cell, its class, computed background colour, link (resolved by the browser) and text.
+const char* const kReadMatrix = R"JS(
+(() => {
+  const t = document.querySelector('table.matrix');
+  if (!t) return null;
+  const engines = Array.from(t.querySelectorAll('thead th')).slice(1).map(th => th.textContent);
+  const rows = Array.from(t.querySelectorAll('tbody tr')).map(tr => {
+    const cells = Array.from(tr.children);
+    return {scene: cells[0].textContent,
+            cells: cells.slice(1).map(td => {
+              const a = td.querySelector('a');
+              return {cls: td.className, colour: getComputedStyle(td).backgroundColor, href: a ? a.href : '',
+                      text: td.textContent};
+            })};
+  });
+  return {engines: engines, rows: rows, matrices: document.querySelectorAll('table.matrix').length};
+})()
+)JS";
+
+TEST(PublishedPages, VerdictMatrixShowsEveryRecordInItsColour) {
+  REQUIRE_CHROMIUM(exe);
+  // The records: every reports/SCENE/comparison.json, scenes in directory order, engines in the
+  // order the records first name them.
+  const fs::path reports = fs::path(TIPPE_SOURCE_DIR) / "reports";
+  std::vector<std::pair<std::string, nlohmann::json>> records;
+  for (const auto& e : fs::directory_iterator(reports))
+    if (fs::exists(e.path() / "comparison.json")) records.push_back({e.path().filename().string(), nlohmann::json::parse(slurp(e.path() / "comparison.json"))});
+  std::sort(records.begin(), records.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  ASSERT_GE(records.size(), 10u);
+  std::vector<std::string> engines;
+  for (const auto& [dir, c] : records)
+    for (const auto& e : c.at("engines"))
+      if (std::find(engines.begin(), engines.end(), e.at("engine").get<std::string>()) == engines.end()) engines.push_back(e.at("engine"));
+  size_t sweeps = 0;
+  for (const auto& e : fs::directory_iterator(reports)) sweeps += fs::exists(e.path() / "records.jsonl") && fs::exists(e.path() / "sweep.json");
+
+  TempDir work("tippe-pages");
+  page_check::Chromium browser(exe, work.path());
+  const auto problems = browser.load(reports / "index.html");
+  ASSERT_TRUE(problems.empty()) << joined(problems);
+  const nlohmann::json m = browser.evaluate(kReadMatrix);
+  ASSERT_TRUE(m.is_object()) << "reports/index.html has no table.matrix";
+  EXPECT_EQ(m.at("matrices").get<size_t>(), 1 + sweeps) << "one matrix for the comparisons and one per published sweep";
+  ASSERT_EQ(m.at("engines").get<std::vector<std::string>>(), engines);
+  ASSERT_EQ(m.at("rows").size(), records.size());
+  std::set<std::string> colours;
+  for (const auto& [kind, colour] : kVerdictColours) colours.insert(colour);
+  EXPECT_EQ(colours.size(), kVerdictColours.size()) << "two verdicts share a colour";
+  for (size_t i = 0; i < records.size(); ++i) {
+    const auto& [dir, c] = records[i];
+    const nlohmann::json& row = m.at("rows")[i];
+    EXPECT_EQ(row.at("scene"), c.at("scene_name"));
+    ASSERT_EQ(row.at("cells").size(), engines.size()) << dir;
+    for (size_t k = 0; k < engines.size(); ++k) {
+      const nlohmann::json& cell = row.at("cells")[k];
+      const auto it = std::find_if(c.at("engines").begin(), c.at("engines").end(),
+                                   [&](const nlohmann::json& e) { return e.at("engine") == engines[k]; });
+      ASSERT_NE(it, c.at("engines").end()) << dir << " has no " << engines[k];
+      const std::string want = expected_verdict(c, *it);
+      const std::string where = dir + " / " + engines[k] + " (" + cell.at("text").get<std::string>() + ")";
+      EXPECT_EQ(cell.at("cls"), "v-" + want) << where;
+      EXPECT_EQ(cell.at("colour"), kVerdictColours.at(want)) << where;
+      // The number in the cell: the signed inversion-time error where both invert.
+      if (want == "1pct" || want == "10pct" || want == "beyond") {
+        const double rel = it->at("metrics").at("inversion_time_rel_error").get<double>();
+        EXPECT_EQ(cell.at("text").get<std::string>().substr(0, 1), rel >= 0 ? "+" : "-") << where;
+        EXPECT_NE(cell.at("text").get<std::string>().find(" %"), std::string::npos) << where;
+      }
+      // The link leads to that scene's page, which exists.
+      const std::string href = cell.at("href");
+      const std::string suffix = "/reports/" + dir + "/index.html";
+      ASSERT_GE(href.size(), suffix.size()) << where;
+      EXPECT_EQ(href.substr(href.size() - suffix.size()), suffix) << where;
+      EXPECT_TRUE(fs::exists(reports / dir / "index.html")) << where;
+    }
   }
 }
 

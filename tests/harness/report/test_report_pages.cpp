@@ -287,13 +287,45 @@ TEST(ReportIndex, OneSentencePerEngineOverEveryScene) {
   const auto v = index_verdicts({a, b});
   ASSERT_EQ(v.size(), 2u);
   EXPECT_EQ(v[0],
-            "ode: the reference's regime on 2 of 2 scenes; inversion-time error 1 % to 5 % on the 2 scenes where both "
-            "invert (largest on fixture).")
+            "ode: the reference's regime on 2 of 2 scenes; inversion-time error 1 % to 5 % where both invert (2 scenes, "
+            "largest on fixture).")
       << v[0];
-  EXPECT_EQ(v[1],
-            "bullet: the reference's regime on 0 of 2 scenes; the wrong regime on fixture (does not invert), second "
-            "(does not invert); no scene where both invert.")
+  EXPECT_EQ(v[1], "bullet: the reference's regime on 0 of 2 scenes, the wrong regime on 2; no scene where both invert.")
       << v[1];
+}
+
+// Each kind of matrix cell from a record: the error's size where both invert, neither inverting,
+// the wrong regime either way, and a run that ended early.
+TEST(ReportIndex, EveryVerdictKindOfTheMatrix) {
+  TempDir dir{"tippe-pages"};
+  json c = make_comparison(dir.path());
+  json& ode = c["engines"][0];
+  const json& bullet = c["engines"][1];
+  EXPECT_EQ(verdict_cell(c, ode).kind, "10pct") << "5 % late";
+  ode["metrics"]["inversion_time_rel_error"] = 0.05;
+  EXPECT_EQ(verdict_cell(c, ode).kind, "10pct");
+  EXPECT_EQ(verdict_cell(c, ode).text, "+5 %");
+  ode["metrics"]["inversion_time_rel_error"] = -0.002;
+  EXPECT_EQ(verdict_cell(c, ode).kind, "1pct");
+  EXPECT_EQ(verdict_cell(c, ode).text, "-0.2 %");
+  ode["metrics"]["inversion_time_rel_error"] = 0.3;
+  EXPECT_EQ(verdict_cell(c, ode).kind, "beyond");
+  const VerdictCell rolls = verdict_cell(c, bullet);
+  EXPECT_EQ(rolls.kind, "wrong");
+  EXPECT_EQ(rolls.text.rfind("rolls; the reference inverts at ", 0), 0u) << rolls.text;
+  json ended = bullet;
+  ended["summary"]["status"] = "diverged";
+  ended["summary"]["status_time"] = 0.5;
+  EXPECT_EQ(verdict_cell(c, ended).kind, "failed");
+  EXPECT_EQ(verdict_cell(c, ended).text.rfind("diverged at ", 0), 0u) << verdict_cell(c, ended).text;
+  // The reference rolls: a rolling engine is in its regime, an inverting one is not.
+  c["reference"]["summary"]["inversion_time"] = nullptr;
+  EXPECT_EQ(verdict_cell(c, bullet).kind, "regime");
+  EXPECT_EQ(verdict_cell(c, c["engines"][0]).kind, "wrong");
+  EXPECT_NE(verdict_cell(c, c["engines"][0]).text.find("; the reference rolls"), std::string::npos);
+  // Six kinds, each with its words and colour.
+  EXPECT_EQ(verdict_kinds().size(), 6u);
+  for (const auto& k : verdict_kinds()) EXPECT_NE(verdict_kind_text(k), k);
 }
 
 TEST(ReportDocument, OneModelRenderedToMarkdownAndHtml) {
@@ -338,10 +370,16 @@ TEST(ReportIndex, TheCommandReadsEverySceneDirectory) {
   ASSERT_EQ(std::system((tippe + " report " + dir.path().string() + " --index-verdict >" + out.string()).c_str()), 0);
   const std::string text = slurp(out);
   EXPECT_EQ(text,
-            "ode: the reference's regime on 1 of 1 scenes; inversion-time error 5 % on the 1 scene where both invert "
-            "(largest on fixture).\n"
-            "bullet: the reference's regime on 0 of 1 scenes; the wrong regime on fixture (does not invert); no scene "
-            "where both invert.\n");
+            "ode: the reference's regime on 1 of 1 scenes; inversion-time error 5 % where both invert (1 scene, largest "
+            "on fixture).\n"
+            "bullet: the reference's regime on 0 of 1 scenes, the wrong regime on 1; no scene where both invert.\n");
+  // --index writes the index page and its Markdown from the records: the matrix, linked cells.
+  ASSERT_EQ(std::system((tippe + " report " + dir.path().string() + " --index >/dev/null").c_str()), 0);
+  const std::string html = slurp(dir.path() / "index.html"), md = slurp(dir.path() / "README.md");
+  EXPECT_NE(html.find("<table class=\"matrix num\">"), std::string::npos) << html;
+  EXPECT_NE(html.find("<thead><tr><th>scene</th><th>ode</th><th>bullet</th></tr></thead>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<td class=\"v-wrong\"><a href=\"fixture/index.html\">rolls; the reference inverts at"), std::string::npos) << html;
+  EXPECT_NE(md.find("| [fixture](fixture/report.md) |"), std::string::npos) << md;
   // A directory with no comparison in it is bad input, exit 2.
   const int rc = std::system((tippe + " report " + (dir.path() / "sweep-x").string() + " --index-verdict 2>/dev/null").c_str());
   EXPECT_EQ(WEXITSTATUS(rc), 2);
