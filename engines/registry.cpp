@@ -12,6 +12,7 @@ const EngineInfo& ode_engine_info();
 const EngineInfo& mujoco_engine_info();
 const EngineInfo& dart_engine_info();
 const EngineInfo& simbody_engine_info();
+const EngineInfo& siconos_engine_info();
 
 const std::vector<EngineInfo>& engine_registry() {
 #ifdef TIPPE_REFERENCE_ONLY
@@ -20,6 +21,7 @@ const std::vector<EngineInfo>& engine_registry() {
 #else
   static const std::vector<EngineInfo> registry = {
       analytic_engine_info(), bullet_engine_info(), ode_engine_info(), mujoco_engine_info(), dart_engine_info(), simbody_engine_info(),
+      siconos_engine_info(),
   };
 #endif
   return registry;
