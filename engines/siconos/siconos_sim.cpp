@@ -399,9 +399,21 @@ void SiconosSimulator::set_state(const BodyState& x) {
     vs.setValue(3 + i, x.w_B(i));
   }
   // Moreau-Jean starts each step from the body's memory of the last step end: the new state
-  // replaces it (and the quaternion's kinematic matrix T follows q).
+  // replaces it (and the quaternion's kinematic matrix T follows q). The contacts' gaps and
+  // normal velocities, and from them the set of contacts the next step activates, are those of
+  // the old state until recomputed: without this the first step after a jump onto the floor
+  // would not see the contact (measured: an impact state set and stepped once kept its energy).
   top_->computeT();
   top_->swapInMemory();
+  try {
+    sim_->updateOutput(0);
+    sim_->updateOutput(1);
+    for (const SP::Interaction& inter : {ball_, stem_})
+      if (inter) inter->swapInMemory();
+    sim_->updateIndexSets();
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(std::string("siconos: set_state: ") + e.what());
+  }
   last_ = probe(read_state());
 }
 

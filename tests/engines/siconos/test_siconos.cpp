@@ -136,12 +136,13 @@ TEST(SiconosCrossCheck, CoulombTopInversionStemContactAndEnergyConvergeToTheRefe
 // FINDING (disabled until the impact laws are reconciled): the energy the stem touchdown removes
 // converges in Siconos (0.02183, 0.02235, 0.02251 at h = 9e-4, 3e-4, 1e-4: first order, limit
 // ~0.0226) to 9.6 % more than the reference's impact removes (0.020609): the error grows down
-// the ladder, and at h = 1e-4 it is 24 times the first-order spread. Both are plastic impacts with Coulomb friction, but with different
-// frictional impact laws: the reference's impulse slides along the PRE-impact slip where it
-// cannot stick (analytic/contact_impacts.cpp), Moreau-Jean's Coulomb cone acts on the POST-impact
-// velocity (Moreau's law, maximal dissipation), and at this touchdown the ball is rolling when
-// the stem lands. The energies after the impact differ accordingly (2.5965 against 2.5969 at
-// t = 8, once rolling again), while every event before it agrees (the test above).
+// the ladder, and at h = 1e-4 it is 24 times the first-order spread. Both are plastic impacts
+// with Coulomb friction, but with different frictional impact laws: the reference's impulse
+// slides along the PRE-impact slip where it cannot stick (analytic/contact_impacts.cpp), Moreau-Jean's Coulomb cone acts on the POST-impact
+// velocity (Moreau's law, maximal dissipation): from the same state the two impacts agree when
+// frictionless or sticking and differ by exactly this where the impulse slides (the tests on the
+// impact from the reference's state, below). The energies after the impact differ accordingly
+// (2.5965 against 2.5969 at t = 8, once rolling again), while every event before it agrees.
 TEST(SiconosCrossCheck, DISABLED_CoulombTopStemImpactLossConvergesToTheReference) {
   const Scene s = coulomb_top();
   const Measured ref = run_reference(s, kCoulombProbe, kCoulombEnd);
@@ -168,6 +169,61 @@ TEST(SiconosCrossCheck, LeineGlockerRollingEnergyAndTiltConvergeToTheReference) 
   expect_first_order("leine_glocker energy at 0.3 s", e, ref.energy_probe);
   expect_first_order("leine_glocker tilt at 0.3 s", th, ref.tilt_probe);
   for (int i = 0; i < 3; ++i) EXPECT_FALSE(std::isfinite(q[i].inversion)) << "h = " << h[i];
+}
+
+// The stem touchdown of the Coulomb top alone, from the reference's own state 1e-9 before it (the
+// stem 1.9e-10 above the floor, approaching; the ball rolling): the reference locates and applies
+// its impact, Siconos takes one step of 1e-8 (whose smooth part is ~1e-8 of the energy).
+struct ImpactLosses {
+  double reference = kNaN, siconos = kNaN;
+};
+ImpactLosses stem_impact_from_the_same_state(double mu) {
+  const Scene s = coulomb_top();
+  const BodyModel m = BodyModel::from_scene(s);
+  auto run = make_simulator("analytic", s);
+  run->advance_to(6.2);
+  const double t_touchdown = event_time(run->events(), "stem_contact");
+  auto to_pre = make_simulator("analytic", s);
+  to_pre->advance_to(t_touchdown - 1e-9);
+  const BodyState pre = to_pre->state();
+  Scene at_mu = s;
+  at_mu.contact.mu = mu;
+  at_mu.engines["siconos"]["timestep"] = 1e-8;
+  ImpactLosses r;
+  for (const char* engine : {"analytic", "siconos"}) {
+    auto sim = make_simulator(engine, at_mu);
+    sim->set_state(pre);
+    sim->advance_to(1e-8);
+    (std::string(engine) == "analytic" ? r.reference : r.siconos) = energy(m, pre) - energy(m, sim->state());
+  }
+  return r;
+}
+
+// Frictionless (mu = 0) and sticking (mu = 1: the impulse stays inside the cone) impacts are the
+// same law in both: a plastic impact projecting the approaching normal velocity (and, sticking,
+// the slip) to zero. Measured: the losses agree to 1.6e-8 (mu = 0, loss 0.0093872) and 1.0e-8
+// (mu = 1, 0.050412) relative, the work of gravity and of the rolling ball over Siconos's step
+// of 1e-8 and the reference's 1e-9 to the touchdown; 1e-7 is 6 times the larger.
+TEST(SiconosCrossCheck, StemImpactFromTheSameStateMatchesWhenFrictionlessOrSticking) {
+  for (const double mu : {0.0, 1.0}) {
+    const ImpactLosses l = stem_impact_from_the_same_state(mu);
+    std::printf("[siconos] stem impact from the reference's state, mu %g: reference %.10g, Siconos %.10g (%.2g relative)\n", mu,
+                l.reference, l.siconos, std::abs(l.siconos - l.reference) / l.reference);
+    EXPECT_GT(l.reference, 0.005) << "mu " << mu << ": the scene no longer has a stem impact";
+    EXPECT_NEAR(l.siconos, l.reference, 1e-7 * l.reference) << "mu " << mu;
+  }
+}
+
+// FINDING (disabled: the frictional impact laws differ where the impulse slides): from the same
+// state, at mu = 0.3 (the scene's) the reference's impact removes 0.020609 and Siconos's 0.022587
+// (9.6 % more); at mu = 0.05, 0.011468 and 0.011625 (1.4 % more). The reference's tangential
+// impulse slides along the PRE-impact slip where it cannot stick (analytic/contact_impacts.cpp);
+// Moreau-Jean's Coulomb cone acts on the POST-impact slip (Moreau's law, maximal dissipation).
+// Neither is Darboux-Keller's integration of the slip over the impact, which lies between where
+// the slip turns during it. This is the whole of the test above's stem-impact difference.
+TEST(SiconosCrossCheck, DISABLED_SlidingStemImpactFromTheSameStateMatches) {
+  const ImpactLosses l = stem_impact_from_the_same_state(0.3);
+  EXPECT_NEAR(l.siconos, l.reference, 1e-7 * l.reference);
 }
 
 TEST(Siconos, RejectsAnUnknownSolverNamingTheKey) {
