@@ -20,6 +20,12 @@ struct SiconosSettings {
   // Moreau-Jean's gamma: the contact is activated when the gap predicted at t + gamma h is
   // closed. Negative: Siconos' default (the gap at the step start plus h/2 of its rate).
   double gamma = -1.0;
+  // MoreauJeanOSI's constraint activation threshold, in units of R: a contact whose predicted gap
+  // is below it takes part in the step's problem. Siconos' default is 0, so a contact at a gap
+  // of round-off above 0 (a top set down on the floor exactly, both contacts at the switching
+  // tilt) is left out and the body falls free for a step. 1e-9 R counts it; an active contact
+  // that is not closed can only stop an approach early, by at most this gap.
+  double activation_margin = 1e-9;
   // The one-step nonsmooth problem (a 3D friction contact problem per step: Signorini and
   // Coulomb on the impulses) is solved by Siconos' numerics: "nsgs" (nonsmooth Gauss-Seidel
   // over the contacts, each solved by a local Newton: Siconos' default for FrictionContact),
@@ -44,6 +50,7 @@ struct SiconosSettings {
     v("timestep", timestep, 1e-8, 1.0);
     v("theta", theta, 0.0, 1.0);
     v("gamma", gamma, -1.0, 1.0);
+    v("activation_margin", activation_margin, 0.0, 1e-3);
     v("solver", solver, {"nsgs", "nsn_ac", "prox"});
     v("tolerance", tolerance, 1e-16, 1.0);
     v("max_iterations", max_iterations, 1, 1000000);

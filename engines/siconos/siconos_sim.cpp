@@ -175,6 +175,7 @@ SiconosSimulator::SiconosSimulator(const Scene& scene)
 
   auto osi = settings_.gamma >= 0 ? std::make_shared<MoreauJeanOSI>(settings_.theta, settings_.gamma)
                                   : std::make_shared<MoreauJeanOSI>(settings_.theta);
+  osi->setConstraintActivationThreshold(settings_.activation_margin * m.R);
   auto td = std::make_shared<TimeDiscretisation>(0.0, settings_.timestep);
   osnspb_ = std::make_shared<FrictionContact>(3, solver_id(settings_.solver));
   osnspb_->numericsSolverOptions()->iparam[SICONOS_IPARAM_MAX_ITER] = settings_.max_iterations;
