@@ -83,7 +83,7 @@ class SiconosSimulator : public Simulator {
   std::string status_detail() const override { return status_detail_; }
   std::vector<Event> events() const override { return events_; }
   SettingsList settings() const override { return list_settings(settings_); }
-  std::vector<std::string> notes() const override { return notes_; }
+  std::vector<std::string> notes() const override;
 
  private:
   struct StepProbe {
@@ -119,6 +119,10 @@ class SiconosSimulator : public Simulator {
   std::string status_detail_;
   std::vector<Event> events_;
   WorkCounters work_;
+  // Steps whose one-step problem ended above its tolerance, or whose Newton loop ended at its
+  // iteration limit: Siconos goes on with the last iterate, so the run says how often.
+  long long solver_unconverged_ = 0, newton_unconverged_ = 0;
+  double worst_residual_ = 0.0;
   StepProbe last_;
   ContactReport report_;
   bool inverted_ = false, stem_touched_ = false;
@@ -226,6 +230,23 @@ void SiconosSimulator::make_notes() {
     notes_.push_back("ball modelled as a full sphere although its cut cap can reach the floor before the stem tip");
 }
 
+std::vector<std::string> SiconosSimulator::notes() const {
+  std::vector<std::string> n = notes_;
+  if (solver_unconverged_ > 0) {
+    std::ostringstream os;
+    os << "the one-step problem did not reach its tolerance " << settings_.tolerance << " in " << solver_unconverged_
+       << " of " << n_steps_ << " steps (largest residual " << worst_residual_ << "; raise max_iterations or the tolerance)";
+    n.push_back(os.str());
+  }
+  if (newton_unconverged_ > 0) {
+    std::ostringstream os;
+    os << "the Newton loop stopped at newton_max_iterations = " << settings_.newton_max_iterations << " in "
+       << newton_unconverged_ << " of " << n_steps_ << " steps";
+    n.push_back(os.str());
+  }
+  return n;
+}
+
 BodyState SiconosSimulator::read_state() const {
   const SiconosVector& q = *top_->q();
   const SiconosVector& v = *top_->twist();
@@ -317,13 +338,23 @@ void SiconosSimulator::step_once() {
   try {
     sim_->computeOneStep();
     sim_->nextStep();
-  } catch (const std::exception& e) {
+  } catch (const Siconos::exception& e) {
     // A singular matrix or a failed solve inside Siconos: a run that ends, not a crash.
+    const std::string* why = boost::get_error_info<Siconos::exception::extra_message>(e);
+    return fail(RunStatus::Failed, time(), "Siconos: " + (why ? *why : std::string(e.what())));
+  } catch (const std::exception& e) {
     return fail(RunStatus::Failed, time(), std::string("Siconos: ") + e.what());
   }
   ++n_steps_;
   work_.steps = work_.rhs_evaluations = n_steps_;
-  work_.solver_iterations += osnspb_->numericsSolverOptions()->iparam[SICONOS_IPARAM_ITER_DONE];
+  const SolverOptions& so = *osnspb_->numericsSolverOptions();
+  work_.solver_iterations += so.iparam[SICONOS_IPARAM_ITER_DONE];
+  // The residual of the last solve (0 when no contact was active).
+  if (so.dparam[SICONOS_DPARAM_RESIDU] > settings_.tolerance) {
+    ++solver_unconverged_;
+    worst_residual_ = std::max(worst_residual_, so.dparam[SICONOS_DPARAM_RESIDU]);
+  }
+  if (sim_->getNewtonNbIterations() >= static_cast<unsigned>(settings_.newton_max_iterations)) ++newton_unconverged_;
   const double t = time();
   report_ = read_contacts();
   const StepProbe now = probe(read_state());
