@@ -56,8 +56,9 @@ install(FILES ${PROJECT_BINARY_DIR}/tippeConfig.cmake ${PROJECT_BINARY_DIR}/tipp
 if(TIPPE_ENGINES)
   set(TIPPE_PC_REQUIRES "eigen3 tomlplusplus nlohmann_json bullet-float64 ode")
   # DART links as its imported target `dart` (libdart and its FCL); the .pc names them directly.
-  # Simbody (engines/simbody/) likewise: its three libraries, no .pc of its own in Debian.
-  set(TIPPE_PC_LIBS "-lmujoco -ldart -lfcl -lSimTKsimbody -lSimTKmath -lSimTKcommon")
+  # Simbody (engines/simbody/) likewise: its three libraries, no .pc of its own in Debian; and
+  # Siconos (engines/siconos/): its kernel and numerics.
+  set(TIPPE_PC_LIBS "-lmujoco -ldart -lfcl -lSimTKsimbody -lSimTKmath -lSimTKcommon -lsiconos_kernel -lsiconos_numerics")
 else()
   set(TIPPE_PC_REQUIRES "eigen3 tomlplusplus nlohmann_json")
   set(TIPPE_PC_LIBS "")

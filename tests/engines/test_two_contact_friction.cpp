@@ -122,7 +122,7 @@ INSTANTIATE_TEST_SUITE_P(Engines, TwoContactFriction, ::testing::ValuesIn(engine
 INSTANTIATE_TEST_SUITE_P(Engines, TwoContactsTouch, ::testing::Values("ode", "bullet", "mujoco"),
                          [](const auto& info) { return info.param; });
 
-INSTANTIATE_TEST_SUITE_P(Engines, TwoContactSamples, ::testing::Values("ode", "bullet", "mujoco", "dart"),
+INSTANTIATE_TEST_SUITE_P(Engines, TwoContactSamples, ::testing::Values("ode", "bullet", "mujoco", "dart", "siconos"),
                          [](const auto& info) { return info.param; });
 // Finding, kept disabled: Simbody's compliant contact (Hunt-Crossley, c = 0.5, its default) has
 // no two-contact phase to label here. When the ball lands its stem at t = 0.2837 s, ball and stem
@@ -139,6 +139,13 @@ INSTANTIATE_TEST_SUITE_P(DISABLED_Simbody, TwoContactSamples, ::testing::Values(
 // 0.3 ms. ODE counts contacts within its surface layer, Bullet within its contact breaking
 // threshold, MuJoCo's soft contact within its margin.
 INSTANTIATE_TEST_SUITE_P(DISABLED_Dart, TwoContactsTouch, ::testing::Values("dart"),
+                         [](const auto& info) { return info.param; });
+// Kept disabled, and not a fault: Siconos reports a contact that carries an impulse (rigid, no
+// margin), and here the stem carries none. Put down at the switching tilt without spin the top
+// tips back onto its ball: the reference stays on the ball, theta falling from 1.9298104 to
+// 1.9297094 in 2 ms, and Siconos the same to 7e-11 rad. The engines with a margin count the
+// stem's touching without force as a contact.
+INSTANTIATE_TEST_SUITE_P(DISABLED_Siconos, TwoContactsTouch, ::testing::Values("siconos"),
                          [](const auto& info) { return info.param; });
 
 }  // namespace

@@ -1,0 +1,494 @@
+// Siconos 4.4 adapter: the top as a Newton-Euler body with unilateral Coulomb contacts (ball, stem tip) on the floor, Moreau-Jean time-stepping.
+//
+// Event-capturing nonsmooth time-stepping: each step of h solves one friction contact problem
+// on the impulses (Signorini, Newton's impact law with restitution 0 as the reference's plastic
+// impacts, Coulomb's cone), with no compliance and no regularization: a contact sticks exactly,
+// an impact is an impulse. The contacts are the kernel's own NewtonEuler3DR relations
+// (siconos_contact.h), not Siconos' mechanics library (whose single-precision Bullet would meet
+// the Bullet adapter's double-precision one in this binary). The checks every engine gets
+// (events, divergence, penetration) run after each step, as in engines/fixed_step.cpp.
+#include <SiconosKernel.hpp>
+#include <SolverOptions.h>
+#include <Friction_cst.h>
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "../../analytic/initial_state.h"
+#include "../../analytic/stop_request.h"
+#include "fixed_step.h"  // ContactReport, FailureLimits: as every engine
+#include "registry.h"
+#include "settings.h"
+#include "siconos_contact.h"
+#include "siconos_settings.h"
+
+namespace tippe {
+namespace {
+
+// Debian's libsiconos-kernel-dev 4.4.0; the headers carry no version macro.
+std::string siconos_version() { return "siconos 4.4.0"; }
+
+// Siconos' numerics calls BLAS and LAPACK on the contact problem's few-by-few blocks. Debian's
+// OpenBLAS (pthread build) starts a thread team for them: a step of this body then costs 2.5 to
+// 5 times its single-thread wall time (1 s of leine_glocker at h = 1e-4: 0.95 s wall with one
+// thread, 4.8 s with the default, on two busy cores). One thread, set once, through the symbol
+// when the BLAS in the process is OpenBLAS (process-wide; only the speed of BLAS calls changes).
+void single_threaded_blas() {
+  static const bool done = [] {
+    using SetThreads = void (*)(int);
+    if (auto f = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) f(1);
+    return true;
+  }();
+  (void)done;
+}
+
+int solver_id(const std::string& s) {
+  if (s == "nsn_ac") return SICONOS_FRICTION_3D_NSN_AC;
+  if (s == "prox") return SICONOS_FRICTION_3D_PROX;
+  return SICONOS_FRICTION_3D_NSGS;
+}
+
+// The friction coefficient of Siconos' own contact for the scene's law (as native_mu of the
+// fixed-step engines): viscous and gliding are forces the bench applies, on frictionless contacts.
+double native_mu(const SiconosSettings& s, const ContactSpec& c) {
+  switch (c.friction) {
+    case FrictionLaw::Coulomb: return c.mu;
+    case FrictionLaw::Rolling: return s.rolling_mu;
+    default: return 0.0;
+  }
+}
+
+class SiconosSimulator : public Simulator {
+ public:
+  explicit SiconosSimulator(const Scene& scene);
+
+  std::string engine() const override { return "siconos"; }
+  std::string version() const override { return siconos_version(); }
+  void advance_to(double t) override;
+  Observation observe() const override;
+  BodyState state() const override { return read_state(); }
+  void set_state(const BodyState& x) override;
+  MassReadback mass_properties() const override;
+  WorkCounters work() const override { return work_; }
+  RunStatus status() const override { return status_; }
+  double status_time() const override { return status_time_; }
+  std::string status_detail() const override { return status_detail_; }
+  std::vector<Event> events() const override { return events_; }
+  SettingsList settings() const override { return list_settings(settings_); }
+  std::vector<std::string> notes() const override;
+
+ private:
+  struct StepProbe {
+    BodyState state;
+    double cos_theta = 1.0, gap_ball = 0.0, gap_stem = 0.0;
+  };
+  double time() const { return static_cast<double>(n_steps_) * settings_.timestep; }
+  BodyState read_state() const;
+  ContactReport read_contacts() const;
+  StepProbe probe(const BodyState& x) const;
+  void bench_forces();
+  void step_once();
+  void track_events(const StepProbe& a, const StepProbe& b);
+  void fail(RunStatus s, double t, const std::string& why);
+  void make_notes();
+
+  Scene scene_;
+  BodyModel body_;
+  SiconosSettings settings_;
+  std::vector<std::string> notes_;
+
+  SP::NewtonEulerDS top_;
+  SP::SiconosVector f_ext_, m_ext_;  // lab frame: gravity plus the bench's forces of the step
+  SP::Interaction ball_, stem_;
+  SP::FrictionContact osnspb_;
+  SP::TimeStepping sim_;
+
+  FailureLimits limits_;
+  long long n_steps_ = 0;
+  double e0_ = 0.0, speed_scale_ = 0.0;
+  RunStatus status_ = RunStatus::Ok;
+  double status_time_ = 0.0;
+  std::string status_detail_;
+  std::vector<Event> events_;
+  WorkCounters work_;
+  // Steps whose one-step problem ended above its tolerance, or whose Newton loop ended at its
+  // iteration limit: Siconos goes on with the last iterate, so the run says how often.
+  long long solver_unconverged_ = 0, newton_unconverged_ = 0;
+  double worst_residual_ = 0.0;
+  StepProbe last_;
+  ContactReport report_;
+  bool inverted_ = false, stem_touched_ = false;
+  Surface contact_surface_ = Surface::Ball;
+};
+
+SiconosSimulator::SiconosSimulator(const Scene& scene)
+    : scene_(scene), body_(BodyModel::from_scene(scene)), settings_(read_settings<SiconosSettings>("siconos", scene)) {
+  const BodyModel& m = body_;
+  if (!(m.M > 0 && m.A > 0 && m.C > 0 && m.R > 0) || (m.stem && !(m.r > 0 && m.l >= 0)))
+    throw std::invalid_argument("siconos: needs M, A, C, R > 0 (and r > 0, l >= 0 with a stem)");
+  const BodyState x0 = scene_initial_state(scene);
+  single_threaded_blas();
+
+  // The body: coordinates (G; quaternion w, x, y, z of B in W), twist (v_G in W; w in B, Siconos'
+  // convention for NewtonEulerDS), the scene's mass and principal inertia about G (never computed
+  // from shapes).
+  auto q = std::make_shared<SiconosVector>(7);
+  auto v = std::make_shared<SiconosVector>(6);
+  const Quat q0 = x0.q_WB.normalized();
+  const double qv[7] = {x0.p_WG.x(), x0.p_WG.y(), x0.p_WG.z(), q0.w(), q0.x(), q0.y(), q0.z()};
+  for (int i = 0; i < 7; ++i) q->setValue(i, qv[i]);
+  for (int i = 0; i < 3; ++i) {
+    v->setValue(i, x0.v_WG(i));
+    v->setValue(3 + i, x0.w_B(i));
+  }
+  auto inertia = std::make_shared<SimpleMatrix>(3, 3);
+  inertia->zero();
+  inertia->setValue(0, 0, m.A);
+  inertia->setValue(1, 1, m.A);
+  inertia->setValue(2, 2, m.C);
+  top_ = std::make_shared<NewtonEulerDS>(q, v, m.M, inertia);
+  f_ext_ = std::make_shared<SiconosVector>(3);
+  m_ext_ = std::make_shared<SiconosVector>(3);
+  f_ext_->zero();
+  m_ext_->zero();
+  f_ext_->setValue(2, -m.M * scene.gravity);
+  top_->setFExtPtr(f_ext_);
+  top_->setMExtPtr(m_ext_);
+  top_->setIsMextExpressedInInertialFrame(true);
+
+  auto nsds = std::make_shared<NonSmoothDynamicalSystem>(0.0, 1e300);
+  nsds->insertDynamicalSystem(top_);
+  // Newton's impact law with restitution 0 (normal and tangential): the reference's impacts are
+  // plastic. One law for both contacts, Coulomb's cone of the scene's mu (0 for the laws the bench
+  // applies itself).
+  auto law = std::make_shared<NewtonImpactFrictionNSL>(0.0, 0.0, native_mu(settings_, scene.contact), 3);
+  ball_ = std::make_shared<Interaction>(law, std::make_shared<SphereOnFloorR>(0.0, 0.0, m.z_O(), m.R));
+  nsds->link(ball_, top_);
+  if (m.stem) {
+    stem_ = std::make_shared<Interaction>(law, std::make_shared<SphereOnFloorR>(0.0, 0.0, m.z_P(), m.r));
+    nsds->link(stem_, top_);
+  }
+
+  auto osi = settings_.gamma >= 0 ? std::make_shared<MoreauJeanOSI>(settings_.theta, settings_.gamma)
+                                  : std::make_shared<MoreauJeanOSI>(settings_.theta);
+  osi->setConstraintActivationThreshold(settings_.activation_margin * m.R);
+  auto td = std::make_shared<TimeDiscretisation>(0.0, settings_.timestep);
+  osnspb_ = std::make_shared<FrictionContact>(3, solver_id(settings_.solver));
+  osnspb_->numericsSolverOptions()->iparam[SICONOS_IPARAM_MAX_ITER] = settings_.max_iterations;
+  osnspb_->numericsSolverOptions()->dparam[SICONOS_DPARAM_TOL] = settings_.tolerance;
+  sim_ = std::make_shared<TimeStepping>(nsds, td, osi, osnspb_);
+  sim_->setNewtonTolerance(settings_.newton_tolerance);
+  sim_->setNewtonMaxIteration(settings_.newton_max_iterations);
+  sim_->initialize();
+
+  const BodyState y0 = read_state();
+  last_ = probe(y0);
+  e0_ = energy(body_, y0);
+  speed_scale_ = std::max({y0.w_B.norm(), y0.v_WG.norm() / m.R, std::sqrt(m.g / m.R), 1e-12});
+  make_notes();
+}
+
+void SiconosSimulator::make_notes() {
+  std::ostringstream os;
+  os << "nonsmooth Moreau-Jean time-stepping, h = " << settings_.timestep << ", theta = " << settings_.theta
+     << ": rigid unilateral contacts, Newton impacts with restitution 0, one friction contact problem per step ("
+     << settings_.solver << ", tolerance " << settings_.tolerance << ")";
+  notes_.push_back(os.str());
+  const ContactSpec& c = scene_.contact;
+  os.str("");
+  switch (c.friction) {
+    case FrictionLaw::Coulomb: os << "Coulomb friction mu = " << c.mu << " in Siconos' 3D cone (exact sticking)"; break;
+    case FrictionLaw::Rolling:
+      os << "rolling approximated by Coulomb friction with mu = " << settings_.rolling_mu << " (exact sticking below the cone)";
+      break;
+    case FrictionLaw::Viscous:
+      os << "viscous friction applied by the bench as an external force (NewtonEulerDS fExt, mExt) at the geometric "
+            "contact point, held over each step from the state at its start; Siconos contacts frictionless";
+      break;
+    case FrictionLaw::Gliding:
+      os << "gliding friction -mu F_n v_C applied by the bench as an external force (NewtonEulerDS fExt, mExt) at each "
+            "geometric contact point, F_n per contact from Siconos' previous step (its impulse / h, explicit); "
+            "Siconos contacts frictionless";
+      break;
+    case FrictionLaw::None: break;
+  }
+  if (!os.str().empty()) notes_.push_back(os.str());
+  if (c.drilling > 0)
+    notes_.push_back("drilling friction NOT modelled: Siconos' 3D friction contact has no torsional friction (its 5D "
+                     "rolling-friction contact adds rolling resistance, not drilling), so this run is of the scene "
+                     "without it (contact.drilling ignored)");
+  const BodyModel& m = body_;
+  if (m.stem && scene_.body.truncation_height > 0 && scene_.body.truncation_height / m.R < (m.R - m.r) / m.l)
+    notes_.push_back("ball modelled as a full sphere although its cut cap can reach the floor before the stem tip");
+}
+
+std::vector<std::string> SiconosSimulator::notes() const {
+  std::vector<std::string> n = notes_;
+  if (solver_unconverged_ > 0) {
+    std::ostringstream os;
+    os << "the one-step problem did not reach its tolerance " << settings_.tolerance << " in " << solver_unconverged_
+       << " of " << n_steps_ << " steps (largest residual " << worst_residual_ << "; raise max_iterations or the tolerance)";
+    n.push_back(os.str());
+  }
+  if (newton_unconverged_ > 0) {
+    std::ostringstream os;
+    os << "the Newton loop stopped at newton_max_iterations = " << settings_.newton_max_iterations << " in "
+       << newton_unconverged_ << " of " << n_steps_ << " steps";
+    n.push_back(os.str());
+  }
+  return n;
+}
+
+BodyState SiconosSimulator::read_state() const {
+  const SiconosVector& q = *top_->q();
+  const SiconosVector& v = *top_->twist();
+  BodyState x;
+  x.t = time();
+  x.p_WG = Vec3(q.getValue(0), q.getValue(1), q.getValue(2));
+  x.q_WB = Quat(q.getValue(3), q.getValue(4), q.getValue(5), q.getValue(6)).normalized();
+  x.v_WG = Vec3(v.getValue(0), v.getValue(1), v.getValue(2));
+  x.w_B = Vec3(v.getValue(3), v.getValue(4), v.getValue(5));
+  return x;
+}
+
+// A contact is what carried an impulse in the last step (Siconos resets every multiplier at the
+// start of a step; an inactive or separating contact ends it at 0). Force = impulse / h.
+ContactReport SiconosSimulator::read_contacts() const {
+  ContactReport r;
+  if (n_steps_ == 0) return r;
+  Vec3 moment = Vec3::Zero();
+  for (const SP::Interaction& inter : {ball_, stem_}) {
+    if (!inter) continue;
+    const double p_n = inter->lambda(1) ? inter->lambda(1)->getValue(0) : 0.0;
+    if (!(p_n > 0)) continue;
+    const double f_n = p_n / settings_.timestep;
+    const bool on_stem = inter == stem_;
+    (on_stem ? r.stem : r.ball) = true;
+    (on_stem ? r.normal_force_stem : r.normal_force_ball) += f_n;
+    r.normal_force += f_n;
+    const auto rel = std::static_pointer_cast<NewtonEuler1DR>(inter->relation());
+    const SiconosVector& pc = *rel->pc1();
+    moment += f_n * Vec3(pc.getValue(0), pc.getValue(1), pc.getValue(2));
+  }
+  if (r.normal_force > 0) {
+    r.point_valid = true;
+    r.p_WC = moment / r.normal_force;
+  }
+  return r;
+}
+
+SiconosSimulator::StepProbe SiconosSimulator::probe(const BodyState& x) const {
+  StepProbe p;
+  p.state = x;
+  p.cos_theta = (x.q_WB * Vec3::UnitZ()).z();
+  p.gap_ball = surface_gap(body_, x, Surface::Ball);
+  p.gap_stem = body_.stem ? surface_gap(body_, x, Surface::Stem) : 1e300;
+  return p;
+}
+
+// The viscous and gliding laws, as the fixed-step loop applies them (engines/fixed_step.cpp):
+// at every contact Siconos has, at its geometric contact point with that point's horizontal
+// velocity, held over the step from the state at its start; the gliding law's F_n is the
+// contact's from the previous step. Gravity is the rest of fExt.
+void SiconosSimulator::bench_forces() {
+  const FrictionLaw law = scene_.contact.friction;
+  if (law != FrictionLaw::Viscous && law != FrictionLaw::Gliding) return;
+  Vec3 f = Vec3::Zero(), mo = Vec3::Zero();
+  const BodyState& x = last_.state;
+  const Vec3 w_W = x.q_WB * x.w_B;
+  for (const Surface s : {Surface::Ball, Surface::Stem}) {
+    if (!(s == Surface::Ball ? report_.ball : report_.stem && body_.stem)) continue;
+    const Vec3 R_C = contact_offset_W(body_, x.q_WB, s);
+    Vec3 v_C = x.v_WG + w_W.cross(R_C);
+    v_C.z() = 0.0;
+    const double f_n = std::max(0.0, s == Surface::Ball ? report_.normal_force_ball : report_.normal_force_stem);
+    const Vec3 F = law == FrictionLaw::Viscous ? Vec3(-scene_.contact.k * v_C) : Vec3(-scene_.contact.mu * f_n * v_C);
+    f += F;
+    mo += R_C.cross(F);
+  }
+  f_ext_->setValue(0, f.x());
+  f_ext_->setValue(1, f.y());
+  f_ext_->setValue(2, f.z() - body_.M * scene_.gravity);
+  for (int i = 0; i < 3; ++i) m_ext_->setValue(i, mo(i));
+}
+
+void SiconosSimulator::fail(RunStatus s, double t, const std::string& why) {
+  status_ = s;
+  status_time_ = t;
+  status_detail_ = why;
+  events_.push_back({to_string(s), t, why, 0.0});
+}
+
+void SiconosSimulator::advance_to(double t) {
+  // The same step budget as the fixed-step engines (kMaxEngineSteps): a run that would take more
+  // steps ends failed before it starts them.
+  const double h = settings_.timestep, horizon = std::max(t, scene_.run.duration);
+  if (status_ == RunStatus::Ok && horizon / h > static_cast<double>(kMaxEngineSteps))
+    return fail(RunStatus::Failed, time(),
+                "step budget: a run to t = " + round_trip_text(horizon) + " takes " + round_trip_text(std::ceil(horizon / h)) +
+                    " steps of " + round_trip_text(h) + ", more than the budget of " + std::to_string(kMaxEngineSteps));
+  // Steps whose end lies within half a step of t count as reaching t (as the fixed-step engines);
+  // a signal ends the run within kStepsPerStopPoll steps.
+  while (status_ == RunStatus::Ok && (static_cast<double>(n_steps_) + 0.5) * h <= t) {
+    if (n_steps_ % kStepsPerStopPoll == 0) poll_stop();
+    step_once();
+  }
+}
+
+void SiconosSimulator::step_once() {
+  bench_forces();
+  try {
+    sim_->computeOneStep();
+    sim_->nextStep();
+  } catch (const Siconos::exception& e) {
+    // A singular matrix or a failed solve inside Siconos: a run that ends, not a crash.
+    const std::string* why = boost::get_error_info<Siconos::exception::extra_message>(e);
+    return fail(RunStatus::Failed, time(), "Siconos: " + (why ? *why : std::string(e.what())));
+  } catch (const std::exception& e) {
+    return fail(RunStatus::Failed, time(), std::string("Siconos: ") + e.what());
+  }
+  ++n_steps_;
+  work_.steps = work_.rhs_evaluations = n_steps_;
+  const SolverOptions& so = *osnspb_->numericsSolverOptions();
+  work_.solver_iterations += so.iparam[SICONOS_IPARAM_ITER_DONE];
+  // The residual of the last solve (0 when no contact was active).
+  if (so.dparam[SICONOS_DPARAM_RESIDU] > settings_.tolerance) {
+    ++solver_unconverged_;
+    worst_residual_ = std::max(worst_residual_, so.dparam[SICONOS_DPARAM_RESIDU]);
+  }
+  if (sim_->getNewtonNbIterations() >= static_cast<unsigned>(settings_.newton_max_iterations)) ++newton_unconverged_;
+  const double t = time();
+  report_ = read_contacts();
+  const StepProbe now = probe(read_state());
+  const BodyState& y = now.state;
+  if (!(y.p_WG.allFinite() && y.v_WG.allFinite() && y.q_WB.coeffs().allFinite() && y.w_B.allFinite()))
+    return fail(RunStatus::Diverged, t, "non-finite state");
+  track_events(last_, now);
+  last_ = now;
+  const double gap = std::min(now.gap_ball, now.gap_stem);
+  if (gap < -limits_.penetration_fraction * body_.R) {
+    std::ostringstream why;
+    why << "fell through the floor: lowest point at " << gap << " (limit " << -limits_.penetration_fraction * body_.R << ")";
+    return fail(RunStatus::Diverged, t, why.str());
+  }
+  const double e = energy(body_, y);
+  if (e0_ > 0 && e > limits_.energy_factor * e0_) {
+    std::ostringstream why;
+    why << "energy " << e << " above " << limits_.energy_factor << " E0 = " << limits_.energy_factor * e0_;
+    return fail(RunStatus::Diverged, t, why.str());
+  }
+  const double speed = std::max(y.w_B.norm(), y.v_WG.norm() / body_.R);
+  if (speed > limits_.speed_factor * speed_scale_) {
+    std::ostringstream why;
+    why << "speed blow-up: " << speed << " rad/s equivalent";
+    return fail(RunStatus::Diverged, t, why.str());
+  }
+}
+
+void SiconosSimulator::track_events(const StepProbe& a, const StepProbe& b) {
+  const double ta = a.state.t, tb = b.state.t;
+  // Located by linear interpolation of the event function across the step, as for the
+  // fixed-step engines.
+  auto cross = [&](double fa, double fb) { return ta + (tb - ta) * fa / (fa - fb); };
+  if (!inverted_ && a.cos_theta > 0 && b.cos_theta <= 0) {
+    inverted_ = true;
+    events_.push_back({"inversion", cross(a.cos_theta, b.cos_theta), "theta crosses 90 deg", 0.0});
+  }
+  const ContactReport& c = report_;
+  if (body_.stem && !stem_touched_ && c.stem) {
+    stem_touched_ = true;
+    const double te = (a.gap_stem > 0 && b.gap_stem <= 0) ? cross(a.gap_stem, b.gap_stem) : tb;
+    events_.push_back({"stem_contact", te, "first stem contact reported by the engine", 0.0});
+  }
+  Surface s = Surface::None;
+  if (c.ball && c.stem) s = Surface::Both;
+  else if (c.ball) s = Surface::Ball;
+  else if (c.stem) s = Surface::Stem;
+  if (s != contact_surface_) {
+    events_.push_back({"switch", tb, std::string(to_string(contact_surface_)) + " -> " + to_string(s), 0.0});
+    contact_surface_ = s;
+  }
+}
+
+Observation SiconosSimulator::observe() const {
+  const BodyState x = state();
+  Observation o = report_.ball && report_.stem ? observe_kinematics_on_both(body_, x) : observe_kinematics(body_, x);
+  o.normal_force = report_.normal_force;
+  o.engine_contact_valid = report_.point_valid;
+  o.p_WC_engine = report_.p_WC;
+  return o;
+}
+
+void SiconosSimulator::set_state(const BodyState& x) {
+  if (!(x.p_WG.allFinite() && x.v_WG.allFinite() && x.q_WB.coeffs().allFinite() && x.w_B.allFinite()) ||
+      x.q_WB.norm() < 1e-12)
+    throw std::invalid_argument("siconos: set_state: non-finite state or zero quaternion");
+  const Quat q = x.q_WB.normalized();
+  SiconosVector& qs = *top_->q();
+  SiconosVector& vs = *top_->twist();
+  const double qv[7] = {x.p_WG.x(), x.p_WG.y(), x.p_WG.z(), q.w(), q.x(), q.y(), q.z()};
+  for (int i = 0; i < 7; ++i) qs.setValue(i, qv[i]);
+  for (int i = 0; i < 3; ++i) {
+    vs.setValue(i, x.v_WG(i));
+    vs.setValue(3 + i, x.w_B(i));
+  }
+  // Moreau-Jean starts each step from the body's memory of the last step end: the new state
+  // replaces it (and the quaternion's kinematic matrix T follows q). The contacts' gaps and
+  // normal velocities, and from them the set of contacts the next step activates, are those of
+  // the old state until recomputed: without this the first step after a jump onto the floor
+  // would not see the contact (measured: an impact state set and stepped once kept its energy).
+  top_->computeT();
+  top_->swapInMemory();
+  try {
+    sim_->updateOutput(0);
+    sim_->updateOutput(1);
+    for (const SP::Interaction& inter : {ball_, stem_})
+      if (inter) inter->swapInMemory();
+    sim_->updateIndexSets();
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(std::string("siconos: set_state: ") + e.what());
+  }
+  last_ = probe(read_state());
+}
+
+MassReadback SiconosSimulator::mass_properties() const {
+  MassReadback r;
+  r.mass = top_->scalarMass();
+  // NewtonEulerDS's body frame is at G (its q is G's position): no offset.
+  const SiconosMatrix& I = *top_->inertia();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.I_G_B(i, j) = I.getValue(i, j);
+  return r;
+}
+
+}  // namespace
+
+std::unique_ptr<Simulator> make_siconos_simulator(const Scene& scene) { return std::make_unique<SiconosSimulator>(scene); }
+
+const EngineInfo& siconos_engine_info() {
+  static const EngineInfo info = [] {
+    EngineInfo e;
+    e.name = "siconos";
+    e.role = EngineRole::Engine;
+    e.make = make_siconos_simulator;
+    set_settings_struct<SiconosSettings>(e);
+    e.version = siconos_version();
+    e.colour = "#000000";  // Okabe-Ito black (its other colours are taken)
+    // The one-step problem's solver (nonsmooth Gauss-Seidel, semismooth Newton, proximal point)
+    // and Moreau-Jean's theta (0.5 trapezoidal, 1 implicit Euler); the step is the cost knob.
+    e.advice_axes = {{"solver", {"\"nsgs\"", "\"nsn_ac\""}}, {"theta", {"0.5", "1"}}};
+    e.cost_knob = "timestep";
+    return e;
+  }();
+  return info;
+}
+
+}  // namespace tippe
