@@ -185,5 +185,34 @@ TEST(ReferenceTouchdown, CascadeIsIntegratedAndClosedByItsApex) {
   EXPECT_NEAR(e_bs, e_dp, 1e-8);
 }
 
+// FINDING, disabled until the reference is fixed: on the dimensionless top under Coulomb friction
+// (mu 0.3, no viscous law) started at tilt 1.8 with spin 2, the reference's two-contact phase
+// gains energy. From the hold at t = 5.19 the top sits on ball and stem at a constant tilt
+// (2.2459 rad), sticking on the ball (slip ~2e-11), with "projection" events removing two-contact
+// drift, and E climbs steadily: 1.36 at t = 6, 1.53 at 8, 2.67 at 20 against E0 = 1.97, status ok.
+// Gravity is conservative and friction and plastic impacts only remove energy, so E may never
+// exceed E0 (here by more than the integration's rtol). Found by the Siconos cross-check's
+// author, reproduced with: tippe run harness/scenes/source_dimensionless.toml --engine analytic
+//   --set contact.friction=coulomb --set contact.k=0 --set contact.mu=0.3 --set initial.spin=2
+//   --set initial.tilt=1.8 --set run.duration=20
+TEST(ReferenceTwoContact, DISABLED_NeverGainsEnergyWhileStickingOnBallAndStem) {
+  Scene s = load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/source_dimensionless.toml");
+  s.contact.friction = FrictionLaw::Coulomb;
+  s.contact.k = 0.0;
+  s.contact.mu = 0.3;
+  s.initial.spin = 2.0;
+  s.initial.tilt = 1.8;
+  ReferenceModel m(s);
+  const double e0 = energy(m.body(), scene_initial_state(s));
+  double e_max = e0, t_max = 0.0;
+  for (double t = 0.01; t <= 10.0 + 1e-12; t += 0.01) {
+    m.advance_to(t);
+    const double e = energy(m.body(), m.state());
+    if (e > e_max) e_max = e, t_max = t;
+  }
+  // 1e-8 E0: 100 times the scene's rtol (1e-10), far above what the integration can add.
+  EXPECT_LE(e_max, e0 * (1.0 + 1e-8)) << "E rises to " << e_max / e0 << " E0 at t = " << t_max;
+}
+
 }  // namespace
 }  // namespace tippe
