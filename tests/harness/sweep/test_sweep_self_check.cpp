@@ -216,7 +216,10 @@ TEST(SweepSelfCheck, UnderMpiACachedReferenceWithoutItHasTheCheckAloneRunAndShar
   for (int np : {2, 3}) {
     const fs::path out = s.dir.path() / ("np" + std::to_string(np));
     fs::create_directories(out);
+    // The sweep's reference cache with the marker that makes the directory a sweep's: a
+    // directory holding a bare reference/ is one tippe did not write, and is refused.
     fs::copy(local / "reference", out / "reference", fs::copy_options::recursive);
+    fs::copy_file(local / ".tippe-output", out / ".tippe-output");
     const CacheEntry entry(out / "reference" / cold_records[0].physics_hash);
     ASSERT_TRUE(fs::remove(entry.dir / "self_check.json"));
     ASSERT_EQ(sweep_runs::run(sweep_runs::mpirun_sweep(np, {s.sweep_path, "--out", out.string()}), log), 0)
