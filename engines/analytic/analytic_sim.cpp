@@ -6,6 +6,7 @@
 #include "adapters.h"
 #include "registry.h"
 #include "settings.h"
+#include "step_checks.h"
 
 namespace tippe {
 
@@ -76,9 +77,7 @@ class AnalyticSimulator final : public Simulator {
   }
   BodyState state() const override { return model_->state(); }
   void set_state(const BodyState& x) override {
-    if (!(x.p_WG.allFinite() && x.v_WG.allFinite() && x.q_WB.coeffs().allFinite() && x.w_B.allFinite()) ||
-        x.q_WB.norm() < 1e-12)
-      throw std::invalid_argument("analytic: set_state: non-finite state or zero quaternion");
+    check_settable_state("analytic", x);
     // The reference restarts its integration from x at the current time (a new initial value
     // problem); the events found so far are kept.
     BodyState y = x;

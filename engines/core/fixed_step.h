@@ -8,37 +8,15 @@
 #include "../../analytic/initial_state.h"
 #include "registry.h"
 #include "simulator.h"
+#include "step_checks.h"
 
 namespace tippe {
-
-// What an engine says about its contacts after a step.
-struct ContactReport {
-  bool ball = false;               // the engine has a contact on the ball geom
-  bool stem = false;               // ... on the stem geom
-  double normal_force = 0.0;       // sum of normal forces on the body (N or scene units)
-  double normal_force_ball = 0.0;  // the part of normal_force on the ball geom
-  double normal_force_stem = 0.0;  // ... on the stem geom
-  bool point_valid = false;
-  Vec3 p_WC = Vec3::Zero();        // engine's contact point (force-weighted mean when several)
-};
-
-// Limits that turn a run into a result instead of a crash (issue: failures are results).
-struct FailureLimits {
-  double energy_factor = 2.0;      // E above energy_factor * E0 (E0 > 0) -> diverged
-  double penetration_fraction = 0.1;  // lowest surface below the floor by more than R/10 -> diverged
-  double speed_factor = 100.0;     // |w| or |v_G| beyond factor * initial scale -> diverged
-};
-
-// The most steps one engine run takes: 1e9 steps are hours of any engine's time (a step costs
-// microseconds), far beyond a run the bench reports on; a timestep far below the run's scale
-// (1e-8 over a long run, a user's model) ends the run as failed with this said, never hangs.
-inline constexpr long long kMaxEngineSteps = 1000000000LL;
 
 // The template of an engine adapter: the stepping loop and every check, the identity (name and
 // version from the engine's EngineInfo) and what an adapter's engine_step leaves behind
 // (contacts, limit hit, solver iterations, notes) are here; an adapter builds its world and
 // implements the protected engine_* calls.
-class FixedStepSimulator : public Simulator {
+class FixedStepSimulator : public CheckedSimulator {
  public:
   std::string engine() const override { return info_.name; }
   std::string version() const override { return info_.version; }
@@ -46,11 +24,6 @@ class FixedStepSimulator : public Simulator {
   void advance_to(double t) override;
   Observation observe() const override;
   WorkCounters work() const override { return work_; }
-  RunStatus status() const override { return status_; }
-  double status_time() const override { return status_time_; }
-  std::string status_detail() const override { return status_detail_; }
-  std::vector<Event> events() const override { return events_; }
-  size_t event_count() const override { return events_.size(); }
   BodyState state() const override { return engine_state(); }
   void set_state(const BodyState& x) override;
 
@@ -83,9 +56,7 @@ class FixedStepSimulator : public Simulator {
   // Writes p_WG, q_WB, v_WG, w_B into the engine at its current time (set_state checks them).
   virtual void engine_set_state(const BodyState& x) = 0;
 
-  // The friction coefficient the engine's own contact carries for the scene's law: mu for
-  // Coulomb, the engine's stand-in rolling_mu for rolling, 0 for none and for the laws the
-  // bench applies itself (viscous, gliding: the engine's contact must then be frictionless).
+  // The friction coefficient the engine's own contact carries (bench_friction.h's native_mu).
   double native_mu(double rolling_mu) const;
   // How an engine words its part in the notes every engine shares about the friction law.
   struct FrictionNoteText {
@@ -114,29 +85,13 @@ class FixedStepSimulator : public Simulator {
 
  private:
   void step_once();
-  // What the per-step checks keep of a step's end.
-  struct StepProbe {
-    BodyState state;
-    double cos_theta = 1.0, gap_ball = 0.0, gap_stem = 0.0;
-  };
-  void track_events(const StepProbe& before, const StepProbe& after);
-  void fail(RunStatus s, double t, const std::string& why);
 
   const EngineInfo& info_;
   Scene scene_;
   BodyModel body_;
-  FailureLimits limits_;
   double dt_ = 0.0;
   long long n_steps_ = 0;
-  double e0_ = 0.0, speed_scale_ = 0.0;
-  RunStatus status_ = RunStatus::Ok;
-  double status_time_ = 0.0;
-  std::string status_detail_;
-  std::vector<Event> events_;
   WorkCounters work_;
-  StepProbe last_;
-  bool inverted_ = false, stem_touched_ = false;
-  Surface contact_surface_ = Surface::None;
 };
 
 }  // namespace tippe

@@ -1,6 +1,6 @@
 // Simbody 3.7 adapter: one free MobilizedBody at G with the ball and the stem tip as Hunt-Crossley spheres on a half-space, integrated with error control.
 //
-// Unlike the four fixed-step engines (engines/fixed_step.h), Simbody has no step to set: its
+// Unlike the fixed-step engines (engines/core/fixed_step.h), Simbody has no step to set: its
 // integrators choose their own steps to an accuracy. advance_to(t) integrates to exactly t, and
 // the checks every engine gets (events, divergence, penetration) run after each accepted internal
 // step, as the shared fixed-step loop runs them after each fixed step.
@@ -17,7 +17,7 @@
 
 #include "../../analytic/initial_state.h"
 #include "../../analytic/stop_request.h"
-#include "fixed_step.h"  // FailureLimits: the same divergence limits as every engine
+#include "step_checks.h"
 #include "registry.h"
 #include "settings.h"
 #include "simbody_settings.h"
@@ -70,15 +70,7 @@ class ViscousContactForce : public SimTK::Force::Custom::Implementation {
   double k_;
 };
 
-// What Simbody's contact subsystem reports for a state (as the fixed-step engines' ContactReport).
-struct Contacts {
-  bool ball = false, stem = false;
-  double normal_force = 0.0, normal_force_ball = 0.0, normal_force_stem = 0.0;
-  bool point_valid = false;
-  Eigen::Vector3d p_WC = Eigen::Vector3d::Zero();
-};
-
-class SimbodySimulator : public Simulator {
+class SimbodySimulator : public CheckedSimulator {
  public:
   explicit SimbodySimulator(const Scene& scene);
 
@@ -90,24 +82,13 @@ class SimbodySimulator : public Simulator {
   void set_state(const BodyState& x) override;
   MassReadback mass_properties() const override;
   WorkCounters work() const override;
-  RunStatus status() const override { return status_; }
-  double status_time() const override { return status_time_; }
-  std::string status_detail() const override { return status_detail_; }
-  std::vector<Event> events() const override { return events_; }
   SettingsList settings() const override { return list_settings(settings_); }
   std::vector<std::string> notes() const override { return notes_; }
 
  private:
-  struct StepProbe {
-    BodyState state;
-    double cos_theta = 1.0, gap_ball = 0.0, gap_stem = 0.0;
-  };
   BodyState read_state(const SimTK::State& s) const;
-  Contacts read_contacts(const SimTK::State& s) const;
-  StepProbe probe(const BodyState& x) const;
+  ContactReport read_contacts(const SimTK::State& s) const;
   void after_step();
-  void track_events(const StepProbe& a, const StepProbe& b);
-  void fail(RunStatus s, double t, const std::string& why);
   void make_integrator();
   void make_notes();
 
@@ -126,22 +107,14 @@ class SimbodySimulator : public Simulator {
   SimTK::ContactSurfaceIndex ball_surface_, stem_surface_;
   std::unique_ptr<SimTK::Integrator> integ_;
 
-  FailureLimits limits_;
-  double e0_ = 0.0, speed_scale_ = 0.0;
-  RunStatus status_ = RunStatus::Ok;
-  double status_time_ = 0.0;
-  std::string status_detail_;
-  std::vector<Event> events_;
   WorkCounters work_;
   long long realizations_before_ = 0, iterations_before_ = 0;  // of integrators replaced by set_state
-  StepProbe last_;
-  Contacts report_;
-  bool inverted_ = false, stem_touched_ = false;
-  Surface contact_surface_ = Surface::Ball;
+  ContactReport report_;
 };
 
 SimbodySimulator::SimbodySimulator(const Scene& scene)
-    : scene_(scene),
+    : CheckedSimulator(scene),
+      scene_(scene),
       body_(BodyModel::from_scene(scene)),
       settings_(read_settings<SimbodySettings>("simbody", scene)),
       friction_(simbody_friction(settings_, scene.contact)),
@@ -199,11 +172,8 @@ SimbodySimulator::SimbodySimulator(const Scene& scene)
   make_integrator();
   integ_->initialize(s);
 
-  const BodyState y0 = read_state(integ_->getState());
-  last_ = probe(y0);
+  checks_.start(read_state(integ_->getState()));
   report_ = read_contacts(integ_->getState());
-  e0_ = energy(body_, y0);
-  speed_scale_ = std::max({y0.w_B.norm(), y0.v_WG.norm() / m.R, std::sqrt(m.g / m.R), 1e-12});
   make_notes();
 }
 
@@ -294,8 +264,8 @@ BodyState SimbodySimulator::read_state(const SimTK::State& s) const {
   return x;
 }
 
-Contacts SimbodySimulator::read_contacts(const SimTK::State& s) const {
-  Contacts r;
+ContactReport SimbodySimulator::read_contacts(const SimTK::State& s) const {
+  ContactReport r;
   Eigen::Vector3d moment = Eigen::Vector3d::Zero();
   const int n = contact_.getNumContactForces(s);
   const SimTK::ContactSnapshot& active = tracker_.getActiveContacts(s);
@@ -319,113 +289,39 @@ Contacts SimbodySimulator::read_contacts(const SimTK::State& s) const {
   return r;
 }
 
-SimbodySimulator::StepProbe SimbodySimulator::probe(const BodyState& x) const {
-  StepProbe p;
-  p.state = x;
-  p.cos_theta = (x.q_WB * Eigen::Vector3d::UnitZ()).z();
-  p.gap_ball = surface_gap(body_, x, Surface::Ball);
-  p.gap_stem = body_.stem ? surface_gap(body_, x, Surface::Stem) : 1e300;
-  return p;
-}
-
-void SimbodySimulator::fail(RunStatus s, double t, const std::string& why) {
-  status_ = s;
-  status_time_ = t;
-  status_detail_ = why;
-  events_.push_back({to_string(s), t, why, 0.0});
-}
-
 void SimbodySimulator::advance_to(double t) {
-  while (status_ == RunStatus::Ok && integ_->getTime() < t) {
+  while (checks_.ok() && integ_->getTime() < t) {
     // A signal ends the run within one of its steps (one relaxed atomic load each).
     poll_stop();
     const double before = integ_->getTime();
     try {
       const auto why = integ_->stepTo(t);
       if (why == SimTK::Integrator::EndOfSimulation) {
-        fail(RunStatus::Failed, integ_->getTime(), "Simbody ended the integration");
+        checks_.fail(RunStatus::Failed, integ_->getTime(), "Simbody ended the integration");
         return;
       }
     } catch (const std::exception& e) {
       // Simbody throws when it cannot reach its accuracy (step below its minimum, a
       // realization that fails): a run that ends, not a crash.
-      fail(RunStatus::Failed, integ_->getTime(), std::string("Simbody: ") + e.what());
+      checks_.fail(RunStatus::Failed, integ_->getTime(), std::string("Simbody: ") + e.what());
       return;
     }
     if (integ_->getTime() > before) after_step();
   }
 }
 
-// The checks of the shared fixed-step loop (engines/fixed_step.cpp), after each accepted step.
+// The checks every engine gets (engines/core/step_checks.h), after each accepted step.
 void SimbodySimulator::after_step() {
   ++work_.steps;
   const SimTK::State& s = integ_->getState();
-  const double t = s.getTime();
   report_ = read_contacts(s);
-  const StepProbe now = probe(read_state(s));
-  const BodyState& y = now.state;
-  if (!(y.p_WG.allFinite() && y.v_WG.allFinite() && y.q_WB.coeffs().allFinite() && y.w_B.allFinite()))
-    return fail(RunStatus::Diverged, t, "non-finite state");
-  track_events(last_, now);
-  last_ = now;
-  const double gap = std::min(now.gap_ball, now.gap_stem);
-  if (gap < -limits_.penetration_fraction * body_.R) {
-    std::ostringstream why;
-    why << "fell through the floor: lowest point at " << gap << " (limit " << -limits_.penetration_fraction * body_.R << ")";
-    return fail(RunStatus::Diverged, t, why.str());
-  }
-  const double e = energy(body_, y);
-  if (e0_ > 0 && e > limits_.energy_factor * e0_) {
-    std::ostringstream why;
-    why << "energy " << e << " above " << limits_.energy_factor << " E0 = " << limits_.energy_factor * e0_;
-    return fail(RunStatus::Diverged, t, why.str());
-  }
-  const double speed = std::max(y.w_B.norm(), y.v_WG.norm() / body_.R);
-  if (speed > limits_.speed_factor * speed_scale_) {
-    std::ostringstream why;
-    why << "speed blow-up: " << speed << " rad/s equivalent";
-    return fail(RunStatus::Diverged, t, why.str());
-  }
+  checks_.after_step(s.getTime(), read_state(s), report_);
 }
 
-void SimbodySimulator::track_events(const StepProbe& a, const StepProbe& b) {
-  const double ta = a.state.t, tb = b.state.t;
-  // Located by linear interpolation of the event function across the step, as for the
-  // fixed-step engines (Simbody's steps are its own, so the interval is the accepted step).
-  auto cross = [&](double fa, double fb) { return ta + (tb - ta) * fa / (fa - fb); };
-  if (!inverted_ && a.cos_theta > 0 && b.cos_theta <= 0) {
-    inverted_ = true;
-    events_.push_back({"inversion", cross(a.cos_theta, b.cos_theta), "theta crosses 90 deg", 0.0});
-  }
-  const Contacts& c = report_;
-  if (body_.stem && !stem_touched_ && c.stem) {
-    stem_touched_ = true;
-    const double te = (a.gap_stem > 0 && b.gap_stem <= 0) ? cross(a.gap_stem, b.gap_stem) : tb;
-    events_.push_back({"stem_contact", te, "first stem contact reported by the engine", 0.0});
-  }
-  Surface s = Surface::None;
-  if (c.ball && c.stem) s = Surface::Both;
-  else if (c.ball) s = Surface::Ball;
-  else if (c.stem) s = Surface::Stem;
-  if (s != contact_surface_) {
-    events_.push_back({"switch", tb, std::string(to_string(contact_surface_)) + " -> " + to_string(s), 0.0});
-    contact_surface_ = s;
-  }
-}
-
-Observation SimbodySimulator::observe() const {
-  const BodyState x = state();
-  Observation o = report_.ball && report_.stem ? observe_kinematics_on_both(body_, x) : observe_kinematics(body_, x);
-  o.normal_force = report_.normal_force;
-  o.engine_contact_valid = report_.point_valid;
-  o.p_WC_engine = report_.p_WC;
-  return o;
-}
+Observation SimbodySimulator::observe() const { return observe_with_contacts(body_, state(), report_); }
 
 void SimbodySimulator::set_state(const BodyState& x) {
-  if (!(x.p_WG.allFinite() && x.v_WG.allFinite() && x.q_WB.coeffs().allFinite() && x.w_B.allFinite()) ||
-      x.q_WB.norm() < 1e-12)
-    throw std::invalid_argument("simbody: set_state: non-finite state or zero quaternion");
+  check_settable_state("simbody", x);
   using namespace SimTK;
   const Quat q = x.q_WB.normalized();
   State s = integ_->getState();
@@ -438,7 +334,7 @@ void SimbodySimulator::set_state(const BodyState& x) {
   iterations_before_ += integ_->getNumIterations();
   integ_->initialize(s);
   report_ = read_contacts(integ_->getState());
-  last_ = probe(read_state(integ_->getState()));
+  checks_.restart(read_state(integ_->getState()));
 }
 
 WorkCounters SimbodySimulator::work() const {

@@ -1,0 +1,41 @@
+// The viscous and gliding laws the bench applies at each contact an engine reports.
+#include "bench_friction.h"
+
+#include <algorithm>
+
+namespace tippe {
+
+double native_mu(const ContactSpec& contact, double rolling_mu) {
+  switch (contact.friction) {
+    case FrictionLaw::Coulomb: return contact.mu;
+    case FrictionLaw::Rolling: return rolling_mu;
+    case FrictionLaw::Viscous:
+    case FrictionLaw::Gliding:
+    case FrictionLaw::None: return 0.0;
+  }
+  return 0.0;
+}
+
+BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSpec& contact, const BodyState& x,
+                                          const ContactReport& c) {
+  BenchFrictionForces out;
+  if (!bench_applies_friction(contact.friction)) return out;
+  const Vec3 w_W = x.q_WB * x.w_B;
+  for (const Surface s : {Surface::Ball, Surface::Stem}) {
+    if (!(s == Surface::Ball ? c.ball : c.stem && body.stem)) continue;
+    const Vec3 R_C = contact_offset_W(body, x.q_WB, s);
+    Vec3 v_C = x.v_WG + w_W.cross(R_C);
+    v_C.z() = 0.0;
+    if (contact.friction == FrictionLaw::Viscous) {
+      out.f_W[out.n] = -contact.k * v_C;
+    } else {
+      const double f_n = std::max(0.0, s == Surface::Ball ? c.normal_force_ball : c.normal_force_stem);
+      out.f_W[out.n] = -contact.mu * f_n * v_C;
+    }
+    out.r_GC_W[out.n] = R_C;
+    ++out.n;
+  }
+  return out;
+}
+
+}  // namespace tippe

@@ -1,0 +1,131 @@
+// The per-step checks every engine adapter shares: limits, step budget, events.
+#include "step_checks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "settings.h"
+
+namespace tippe {
+
+const char* to_string(RunStatus s) {
+  switch (s) {
+    case RunStatus::Ok: return "ok";
+    case RunStatus::ContactLost: return "contact_lost";
+    case RunStatus::Diverged: return "diverged";
+    case RunStatus::Unphysical: return "unphysical";
+    case RunStatus::Clamped: return "clamped";
+    case RunStatus::Failed: return "failed";
+  }
+  return "?";
+}
+
+void check_settable_state(const std::string& engine, const BodyState& x) {
+  if (!(x.p_WG.allFinite() && x.v_WG.allFinite() && x.q_WB.coeffs().allFinite() && x.w_B.allFinite()) ||
+      x.q_WB.norm() < 1e-12)
+    throw std::invalid_argument(engine + ": set_state: non-finite state or zero quaternion");
+}
+
+Observation observe_with_contacts(const BodyModel& body, const BodyState& x, const ContactReport& c) {
+  Observation o = c.ball && c.stem ? observe_kinematics_on_both(body, x) : observe_kinematics(body, x);
+  o.normal_force = c.normal_force;
+  o.engine_contact_valid = c.point_valid;
+  o.p_WC_engine = c.p_WC;
+  return o;
+}
+
+StepChecks::StepProbe StepChecks::probe(const BodyState& x) const {
+  StepProbe p;
+  p.state = x;
+  p.cos_theta = (x.q_WB * Vec3::UnitZ()).z();
+  p.gap_ball = surface_gap(body_, x, Surface::Ball);
+  p.gap_stem = body_.stem ? surface_gap(body_, x, Surface::Stem) : 1e300;
+  return p;
+}
+
+void StepChecks::start(const BodyState& x0) {
+  last_ = probe(x0);
+  e0_ = energy(body_, x0);
+  speed_scale_ = std::max({x0.w_B.norm(), x0.v_WG.norm() / body_.R, std::sqrt(body_.g / body_.R), 1e-12});
+  contact_surface_ = Surface::Ball;
+}
+
+void StepChecks::restart(const BodyState& x) { last_ = probe(x); }
+
+void StepChecks::fail(RunStatus s, double t, const std::string& why) {
+  status_ = s;
+  status_time_ = t;
+  status_detail_ = why;
+  events_.push_back({to_string(s), t, why, 0.0});
+}
+
+bool StepChecks::within_budget(double horizon, double h, double now) {
+  if (status_ != RunStatus::Ok || !(horizon / h > static_cast<double>(kMaxEngineSteps))) return true;
+  fail(RunStatus::Failed, now,
+       "step budget: a run to t = " + round_trip_text(horizon) + " takes " + round_trip_text(std::ceil(horizon / h)) +
+           " steps of " + round_trip_text(h) + ", more than the budget of " + std::to_string(kMaxEngineSteps));
+  return false;
+}
+
+bool StepChecks::after_step(double t, const BodyState& y, const ContactReport& c) {
+  // Only what the checks need (the full observables are computed when observed): this runs
+  // every engine step, so its cost is the adapter's overhead.
+  const bool finite = y.p_WG.allFinite() && y.v_WG.allFinite() && y.q_WB.coeffs().allFinite() && y.w_B.allFinite();
+  if (!finite) {
+    fail(RunStatus::Diverged, t, "non-finite state");
+    return false;
+  }
+  const StepProbe now = probe(y);
+  track_events(last_, now, c);
+  last_ = now;
+  const double gap = std::min(now.gap_ball, now.gap_stem);
+  if (gap < -limits_.penetration_fraction * body_.R) {
+    std::ostringstream why;
+    why << "fell through the floor: lowest point at " << gap << " (limit " << -limits_.penetration_fraction * body_.R << ")";
+    fail(RunStatus::Diverged, t, why.str());
+    return false;
+  }
+  const double e = energy(body_, y);
+  if (e0_ > 0 && e > limits_.energy_factor * e0_) {
+    std::ostringstream why;
+    why << "energy " << e << " above " << limits_.energy_factor << " E0 = " << limits_.energy_factor * e0_;
+    fail(RunStatus::Diverged, t, why.str());
+    return false;
+  }
+  const double speed = std::max(y.w_B.norm(), y.v_WG.norm() / body_.R);
+  if (speed > limits_.speed_factor * speed_scale_) {
+    std::ostringstream why;
+    why << "speed blow-up: " << speed << " rad/s equivalent";
+    fail(RunStatus::Diverged, t, why.str());
+    return false;
+  }
+  return true;
+}
+
+void StepChecks::track_events(const StepProbe& a, const StepProbe& b, const ContactReport& c) {
+  const double ta = a.state.t, tb = b.state.t;
+  // An engine's dense output is piecewise linear between its steps (fixed or its own): events
+  // are located by linear interpolation of the event function between the two step ends.
+  auto cross = [&](double fa, double fb) { return ta + (tb - ta) * fa / (fa - fb); };
+  if (!inverted_ && a.cos_theta > 0 && b.cos_theta <= 0) {
+    inverted_ = true;
+    events_.push_back({"inversion", cross(a.cos_theta, b.cos_theta), "theta crosses 90 deg", 0.0});
+  }
+  if (body_.stem && !stem_touched_ && c.stem) {
+    stem_touched_ = true;
+    const double te = (a.gap_stem > 0 && b.gap_stem <= 0) ? cross(a.gap_stem, b.gap_stem) : tb;
+    events_.push_back({"stem_contact", te, "first stem contact reported by the engine", 0.0});
+  }
+  Surface s = Surface::None;
+  if (c.ball && c.stem) s = Surface::Both;
+  else if (c.ball) s = Surface::Ball;
+  else if (c.stem) s = Surface::Stem;
+  if (s != contact_surface_) {
+    events_.push_back({"switch", tb, std::string(to_string(contact_surface_)) + " -> " + to_string(s), 0.0});
+    contact_surface_ = s;
+  }
+}
+
+}  // namespace tippe

@@ -1,0 +1,109 @@
+// The per-step checks every engine adapter shares, fixed-step or not: the failure limits, the
+// step budget, the event probes (inversion, first stem contact, contact surface switches).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "../../analytic/initial_state.h"
+#include "simulator.h"
+
+namespace tippe {
+
+// What an engine says about its contacts after a step.
+struct ContactReport {
+  bool ball = false;               // the engine has a contact on the ball geom
+  bool stem = false;               // ... on the stem geom
+  double normal_force = 0.0;       // sum of normal forces on the body (N or scene units)
+  double normal_force_ball = 0.0;  // the part of normal_force on the ball geom
+  double normal_force_stem = 0.0;  // ... on the stem geom
+  bool point_valid = false;
+  Vec3 p_WC = Vec3::Zero();        // engine's contact point (force-weighted mean when several)
+};
+
+// Limits that turn a run into a result instead of a crash (issue: failures are results).
+struct FailureLimits {
+  double energy_factor = 2.0;      // E above energy_factor * E0 (E0 > 0) -> diverged
+  double penetration_fraction = 0.1;  // lowest surface below the floor by more than R/10 -> diverged
+  double speed_factor = 100.0;     // |w| or |v_G| beyond factor * initial scale -> diverged
+};
+
+// The most steps one engine run takes: 1e9 steps are hours of any engine's time (a step costs
+// microseconds), far beyond a run the bench reports on; a timestep far below the run's scale
+// (1e-8 over a long run, a user's model) ends the run as failed with this said, never hangs.
+inline constexpr long long kMaxEngineSteps = 1000000000LL;
+
+// Throws std::invalid_argument ("ENGINE: set_state: ...") for a state no engine can take.
+void check_settable_state(const std::string& engine, const BodyState& x);
+
+// One run's checks and events. An adapter calls start() once its engine is built, after_step()
+// after every step the engine accepted (fixed or its own), restart() after set_state, and fail()
+// for what only it can see (an engine error, a limit of its own). The run's status, events and
+// the state the last step ended in are read from here.
+class StepChecks {
+ public:
+  explicit StepChecks(const BodyModel& body) : body_(body) {}
+
+  // The initial state: the probes, E0 and the speed scale the limits are relative to.
+  void start(const BodyState& x0);
+  // A state set from outside: the probes restart from it, so no crossing is found across the jump.
+  void restart(const BodyState& x);
+  // After a step ending at time t in state y with the engine's contacts c: events, then the
+  // limits in a fixed order (finite, penetration, energy, speed). False when the run ended.
+  bool after_step(double t, const BodyState& y, const ContactReport& c);
+  // The step budget: a run to `horizon` with steps of h that would take more than
+  // kMaxEngineSteps ends failed at `now` before it starts them. False when it did.
+  bool within_budget(double horizon, double h, double now);
+  void fail(RunStatus s, double t, const std::string& why);
+
+  bool ok() const { return status_ == RunStatus::Ok; }
+  RunStatus status() const { return status_; }
+  double status_time() const { return status_time_; }
+  const std::string& status_detail() const { return status_detail_; }
+  const std::vector<Event>& events() const { return events_; }
+  // The state the last accepted step ended in (or the start's, or set_state's).
+  const BodyState& last_state() const { return last_.state; }
+
+ private:
+  struct StepProbe {
+    BodyState state;
+    double cos_theta = 1.0, gap_ball = 0.0, gap_stem = 0.0;
+  };
+  StepProbe probe(const BodyState& x) const;
+  void track_events(const StepProbe& before, const StepProbe& after, const ContactReport& c);
+
+  BodyModel body_;
+  FailureLimits limits_;
+  double e0_ = 0.0, speed_scale_ = 0.0;
+  RunStatus status_ = RunStatus::Ok;
+  double status_time_ = 0.0;
+  std::string status_detail_;
+  std::vector<Event> events_;
+  StepProbe last_;
+  bool inverted_ = false, stem_touched_ = false;
+  Surface contact_surface_ = Surface::Ball;
+};
+
+// The observables of state x with the engine's contacts c: ball and stem on the floor together,
+// as the engine reports its contacts, make the sample one on both surfaces, as the reference's
+// are in its two-contact phase. Jellett's J is conserved on one surface only, so such samples
+// end a run of the J check (SampleSummary). Labelled by the lower surface alone, an engine's
+// two-contact phase was checked as a run on the stem, and its J "drift" there (0.34 to 0.40 of J
+// on extremes/tilt_near_pi, every engine alike) classed it unphysical.
+Observation observe_with_contacts(const BodyModel& body, const BodyState& x, const ContactReport& c);
+
+// The base of every engine adapter: the run's status and events are its StepChecks'.
+class CheckedSimulator : public Simulator {
+ public:
+  RunStatus status() const override { return checks_.status(); }
+  double status_time() const override { return checks_.status_time(); }
+  std::string status_detail() const override { return checks_.status_detail(); }
+  std::vector<Event> events() const override { return checks_.events(); }
+  size_t event_count() const override { return checks_.events().size(); }
+
+ protected:
+  explicit CheckedSimulator(const Scene& scene) : checks_(BodyModel::from_scene(scene)) {}
+  StepChecks checks_;
+};
+
+}  // namespace tippe
