@@ -54,7 +54,9 @@ std::vector<std::string> tippe_names(const fs::path& dir) {
   const std::string text = slurp(dir / tippe::kOutputMarker);
   if (text.empty()) return names;
   names.push_back(tippe::kOutputMarker);
-  for (const auto& f : nlohmann::json::parse(text).at("files")) names.push_back(f.get<std::string>());
+  // The parsed marker outlives the loop (a range over a temporary's member would not).
+  const nlohmann::json marker = nlohmann::json::parse(text);
+  for (const auto& f : marker.at("files")) names.push_back(f.get<std::string>());
   return names;
 }
 
