@@ -438,6 +438,20 @@ void ReferenceModel::Impl::handle(const EvFn& fn, double te) {
     default:
       break;
   }
+  if (next.slot[0].active && next.slot[1].active) {
+    // A change at one of two held contacts (a stick above all: its friction jumps from the
+    // sliding to the sticking value) moves the other's normal force by a jump. Where that
+    // leaves a held contact pulling (F_n < 0), its NormalForce event starts negative and
+    // never fires: the floor would pull that contact down, and its sliding friction
+    // -mu F_n s/|s| with F_n < 0 pushes along the slip, a power mu |F_n| |s| > 0 (held with a
+    // ball stuck on the floor, the stem took E from 0.67 to 1.36 E0 in 15 time units,
+    // docs/findings/reference-two-contact-energy-gain.md). The mode is settled again: the
+    // pulling contact lifts.
+    const ContactForces f = forces_at(y, next);
+    bool pulling = false;
+    for (int k = 0; k < 2; ++k) pulling = pulling || (!next.slot[k].graze && f.normal[k] < 0);
+    if (pulling) next = settle(y, {true, true}, next);
+  }
   for (int k = 0; k < 2; ++k)
     if (!next.slot[k].active && (mode.slot[k].active || (fn.kind == EvKind::Touchdown && k == s))) {
       released_at_rest[k] = fn.kind != EvKind::Touchdown;
