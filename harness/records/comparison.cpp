@@ -15,6 +15,49 @@ namespace tippe {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+namespace {
+
+json count(const std::optional<long long>& v) { return v ? json(*v) : json(nullptr); }
+
+// The event alignment's fields, absent in records written before it existed: read as absent.
+// Present, each is checked (a count >= 0, a time >= 0, a string or null).
+void read_event_alignment(const json& j, Metrics& m) {
+  auto optional_count = [&](const char* key, std::optional<long long>& out) {
+    if (!j.contains(key) || j.at(key).is_null()) return;
+    const json& v = j.at(key);
+    if (!v.is_number_integer() || v.get<long long>() < 0)
+      throw std::invalid_argument(std::string("metrics.") + key + ": " + v.dump() + " is not a count >= 0 or null");
+    out = v.get<long long>();
+  };
+  auto optional_time = [&](const char* key, std::optional<double>& out) {
+    if (!j.contains(key) || j.at(key).is_null()) return;
+    const json& v = j.at(key);
+    if (!v.is_number() || !(std::isfinite(v.get<double>()) && v.get<double>() >= 0))
+      throw std::invalid_argument(std::string("metrics.") + key + ": " + v.dump() + " is not a time >= 0 or null");
+    out = v.get<double>();
+  };
+  auto optional_text = [&](const char* key, std::string& out) {
+    if (!j.contains(key) || j.at(key).is_null()) return;
+    if (!j.at(key).is_string())
+      throw std::invalid_argument(std::string("metrics.") + key + ": " + j.at(key).dump() + " is not a string or null");
+    out = j.at(key).get<std::string>();
+  };
+  optional_count("events_reference", m.events_reference);
+  optional_count("events_engine", m.events_engine);
+  optional_count("events_matched", m.events_matched);
+  optional_count("events_missing", m.events_missing);
+  optional_count("events_extra", m.events_extra);
+  optional_time("event_time_max_error", m.event_time_max_error);
+  optional_count("first_wrong_event_index", m.first_wrong_event_index);
+  optional_text("first_wrong_event", m.first_wrong_event);
+  optional_text("events_not_compared", m.events_not_compared);
+  optional_time("event_min_dwell", m.event_min_dwell);
+  if (m.first_wrong_event_index.has_value() == m.first_wrong_event.empty())
+    throw std::invalid_argument("metrics.first_wrong_event: present without first_wrong_event_index, or the reverse");
+}
+
+}  // namespace
+
 json to_json(const Metrics& m) {
   return json{
       {"inversion_event", m.inversion_event},
@@ -44,6 +87,16 @@ json to_json(const Metrics& m) {
       {"cost_ratio", number(m.cost_ratio)},
       {"compared_until", number(m.compared_until)},
       {"reference_converged_until", number(m.reference_converged_until)},
+      {"events_reference", count(m.events_reference)},
+      {"events_engine", count(m.events_engine)},
+      {"events_matched", count(m.events_matched)},
+      {"events_missing", count(m.events_missing)},
+      {"events_extra", count(m.events_extra)},
+      {"event_time_max_error", number(m.event_time_max_error)},
+      {"first_wrong_event_index", count(m.first_wrong_event_index)},
+      {"first_wrong_event", m.first_wrong_event.empty() ? json(nullptr) : json(m.first_wrong_event)},
+      {"events_not_compared", m.events_not_compared},
+      {"event_min_dwell", number(m.event_min_dwell)},
   };
 }
 
@@ -85,6 +138,7 @@ Metrics metrics_from_json(const json& j) {
       m.reference_converged_until = t;
     }
   }
+  read_event_alignment(j, m);
   return m;
 }
 
