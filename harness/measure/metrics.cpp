@@ -179,6 +179,15 @@ Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, con
     m.first_wrong_event = a.first_wrong_text;
     m.events_not_compared = not_compared_text(ref_seq, eng_seq);
     m.event_min_dwell = dwell;
+    m.event_alignment_rows = static_cast<long long>(a.pairs.size());
+    for (size_t k = 0; k < a.pairs.size() && k < kMaxAlignedEventRowsKept; ++k) {
+      const AlignedPair& p = a.pairs[k];
+      AlignedEventRow row;
+      row.op = to_string(p.op);
+      if (p.reference) row.reference_kind = a.reference[*p.reference].kind, row.reference_time = a.reference[*p.reference].time;
+      if (p.engine) row.engine_kind = a.engine[*p.engine].kind, row.engine_time = a.engine[*p.engine].time;
+      m.event_alignment.push_back(std::move(row));
+    }
   }
 
   const double R = scene.body.sphere_radius;

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 #include <set>
+#include <tuple>
 #include <stdexcept>
 #include "io/json_fields.h"
 #include "io/scene_io.h"
@@ -52,6 +53,34 @@ void read_event_alignment(const json& j, Metrics& m) {
   optional_text("first_wrong_event", m.first_wrong_event);
   optional_text("events_not_compared", m.events_not_compared);
   optional_time("event_min_dwell", m.event_min_dwell);
+  optional_count("event_alignment_rows", m.event_alignment_rows);
+  if (j.contains("event_alignment") && !j.at("event_alignment").is_null()) {
+    const json& rows = j.at("event_alignment");
+    if (!rows.is_array()) throw std::invalid_argument("metrics.event_alignment: " + rows.dump() + " is not an array");
+    static const std::set<std::string> ops = {"match", "substitution", "missing", "extra"};
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const json& r = rows.at(i);
+      const std::string where = "metrics.event_alignment[" + std::to_string(i) + "]";
+      if (!r.is_object() || !r.contains("op") || !r.at("op").is_string() || !ops.count(r.at("op").get<std::string>()))
+        throw std::invalid_argument(where + ".op: expected one of match, substitution, missing, extra");
+      AlignedEventRow row;
+      row.op = r.at("op").get<std::string>();
+      for (const auto& [side, kind, time] : {std::tuple<const char*, std::string*, std::optional<double>*>{
+                                                 "reference", &row.reference_kind, &row.reference_time},
+                                             {"engine", &row.engine_kind, &row.engine_time}}) {
+        const std::string tkey = std::string("t_") + side;
+        if (r.contains(side) && !r.at(side).is_null()) {
+          if (!r.at(side).is_string()) throw std::invalid_argument(where + "." + side + ": not a string or null");
+          *kind = r.at(side).get<std::string>();
+        }
+        if (r.contains(tkey) && !r.at(tkey).is_null()) {
+          if (!r.at(tkey).is_number()) throw std::invalid_argument(where + "." + tkey + ": not a number or null");
+          *time = r.at(tkey).get<double>();
+        }
+      }
+      m.event_alignment.push_back(std::move(row));
+    }
+  }
   if (m.first_wrong_event_index.has_value() == m.first_wrong_event.empty())
     throw std::invalid_argument("metrics.first_wrong_event: present without first_wrong_event_index, or the reverse");
 }
@@ -59,6 +88,13 @@ void read_event_alignment(const json& j, Metrics& m) {
 }  // namespace
 
 json to_json(const Metrics& m) {
+  json rows = json::array();
+  for (const AlignedEventRow& r : m.event_alignment)
+    rows.push_back({{"op", r.op},
+                    {"reference", r.reference_kind.empty() ? json(nullptr) : json(r.reference_kind)},
+                    {"t_reference", number(r.reference_time)},
+                    {"engine", r.engine_kind.empty() ? json(nullptr) : json(r.engine_kind)},
+                    {"t_engine", number(r.engine_time)}});
   return json{
       {"inversion_event", m.inversion_event},
       {"inversion_time_abs_error", number(m.inversion_time_abs_error)},
@@ -97,6 +133,8 @@ json to_json(const Metrics& m) {
       {"first_wrong_event", m.first_wrong_event.empty() ? json(nullptr) : json(m.first_wrong_event)},
       {"events_not_compared", m.events_not_compared},
       {"event_min_dwell", number(m.event_min_dwell)},
+      {"event_alignment", rows},
+      {"event_alignment_rows", count(m.event_alignment_rows)},
   };
 }
 

@@ -11,6 +11,18 @@
 
 namespace tippe {
 
+// One row of the aligned event sequences (measure/event_alignment.h): "match", "substitution",
+// "missing" (the reference's only) or "extra" (the engine's only); a side without an event there
+// has an empty kind and no time.
+struct AlignedEventRow {
+  std::string op;
+  std::string reference_kind, engine_kind;
+  std::optional<double> reference_time, engine_time;
+};
+// The rows a record keeps of an alignment (the first ones; the counts are of all of them): the
+// report shows them, and a sweep's records.jsonl carries them on every line.
+inline constexpr size_t kMaxAlignedEventRowsKept = 20;
+
 // Metrics of one engine against the reference. Event metrics: an event one side has and the
 // other lacks is a finding: `*_event` says which ("both", "neither", "engine_only",
 // "reference_only") and the errors are then absent (null in JSON).
@@ -45,6 +57,8 @@ struct Metrics {
   std::string first_wrong_event;  // "reference: X at t=.., engine: Y at t=.."; "" when none is wrong
   std::string events_not_compared;  // events left out of the comparison, counted ("stick 1 (reference)")
   std::optional<double> event_min_dwell;  // s: surface phases shorter than this merged (a bench setting)
+  std::vector<AlignedEventRow> event_alignment;  // the first kMaxAlignedEventRowsKept aligned pairs
+  std::optional<long long> event_alignment_rows;  // how many pairs the whole alignment has
 };
 
 nlohmann::json to_json(const Metrics& m);

@@ -1,12 +1,8 @@
 // The event-sequence section of the comparison report: the alignment's counts per engine and the aligned sequences.
 #include "report/compare_events.h"
 
-#include <cmath>
-#include <limits>
 #include <string>
-#include <vector>
 
-#include "measure/event_alignment.h"
 #include "report/report_text.h"
 
 namespace tippe {
@@ -15,20 +11,6 @@ namespace {
 
 using nlohmann::json;
 using namespace report_text;
-
-// The rows of an aligned sequence shown per engine: the first wrong event is always among them
-// when it comes early; a long chatter is summarised by the counts above rather than listed.
-constexpr size_t kMaxRowsShown = 40;
-
-std::vector<Event> events_of(const json& summary) {
-  std::vector<Event> out;
-  if (!summary.contains("events") || !summary.at("events").is_array()) return out;
-  for (const json& e : summary.at("events")) {
-    if (!e.is_object()) continue;
-    out.push_back({str(e, "name"), num(e, "time"), str(e, "detail"), 0.0});
-  }
-  return out;
-}
 
 std::string count_text(const json& m, const char* key) {
   return has_number(m, key) ? std::to_string(m.at(key).get<long long>()) : "-";
@@ -70,32 +52,29 @@ void add_event_sequences(Document& d, const json& c) {
   }
   d.table(t);
 
-  const json& ref_summary = c.at("reference").at("summary");
   for (const json& e : c.at("engines")) {
     const json& m = e.at("metrics");
     if (!has_number(m, "events_matched")) continue;
-    const double dwell = has_number(m, "event_min_dwell") ? num(m, "event_min_dwell") : 0.0;
-    const double until = has_number(m, "reference_converged_until") ? num(m, "reference_converged_until")
-                                                                     : std::numeric_limits<double>::infinity();
-    const CanonicalSequence rs = canonical_events(events_of(ref_summary), dwell, until);
-    const CanonicalSequence es = canonical_events(events_of(e.at("summary")), dwell, until);
-    const EventAlignment a = align_events(rs.events, es.events);
     DocTable rows;
     rows.header = {"#", "reference", "engine", "alignment", "time error"};
     rows.css = "detail";
-    for (size_t k = 0; k < a.pairs.size() && k < kMaxRowsShown; ++k) {
-      const AlignedPair& p = a.pairs[k];
-      const bool ok = p.op == AlignOp::Match;
-      rows.rows.push_back({DocCell(std::to_string(k)), DocCell(event_text(a.reference, p.reference)),
-                           DocCell(event_text(a.engine, p.engine)), DocCell(to_string(p.op), ok ? "" : "bad"),
-                           DocCell(ok ? fmt(a.engine[*p.engine].time - a.reference[*p.reference].time) : "")});
-    }
-    std::string summary = str(e, "engine") + ": " + std::to_string(a.pairs.size()) + " aligned events";
-    if (a.pairs.size() > kMaxRowsShown) summary += " (the first " + std::to_string(kMaxRowsShown) + " shown)";
-    // comparison.json keeps the first switch events of a chattering run only (kMaxSwitchEventsKept):
-    // the rows then stop where the record does, while the counts above are of the whole run.
-    if (e.at("summary").contains("events_omitted") || ref_summary.contains("events_omitted"))
-      summary += "; the record keeps only the first switch events, so rows past them are not shown";
+    auto side = [](const json& r, const char* kind, const char* time) {
+      if (!r.contains(kind) || !r.at(kind).is_string()) return std::string("none");
+      return r.at(kind).get<std::string>() + " at t=" + fmt(num(r, time));
+    };
+    size_t k = 0;
+    if (m.contains("event_alignment") && m.at("event_alignment").is_array())
+      for (const json& r : m.at("event_alignment")) {
+        const std::string op = str(r, "op");
+        const bool ok = op == "match";
+        rows.rows.push_back({DocCell(std::to_string(k++)), DocCell(side(r, "reference", "t_reference")),
+                             DocCell(side(r, "engine", "t_engine")), DocCell(op, ok ? "" : "bad"),
+                             DocCell(ok ? fmt(num(r, "t_engine") - num(r, "t_reference")) : "")});
+      }
+    const std::string total = count_text(m, "event_alignment_rows");
+    std::string summary = str(e, "engine") + ": " + total + " aligned events";
+    if (has_number(m, "event_alignment_rows") && num(m, "event_alignment_rows") > static_cast<double>(k))
+      summary += " (the first " + std::to_string(k) + " kept in the record)";
     const std::string left_out = str(m, "events_not_compared");
     if (!left_out.empty()) summary += "; not compared: " + left_out;
     if (rows.rows.empty()) rows.rows.push_back({"-", "none", "none", "", ""});

@@ -9,9 +9,8 @@ namespace tippe {
 
 // Adds "Event sequences" to `d` from a comparison record (comparison.json as JSON): one summary
 // table (per engine: events compared, matched, missing, extra, largest time error, first wrong
-// event, from the metrics) and per engine a folded table of the aligned sequences, re-aligned
-// from the summaries' events (measure/event_alignment.h) with the dwell and window the metrics
-// record. Nothing when no engine's metrics carry the alignment (records older than it).
+// event) and per engine a folded table of the aligned pairs the record keeps, all from the
+// metrics. Nothing when no engine's metrics carry the alignment (records older than it).
 void add_event_sequences(Document& d, const nlohmann::json& comparison);
 
 }  // namespace tippe

@@ -1,6 +1,7 @@
 // Tests of the event-sequence alignment: the canonical vocabulary, the edit-distance alignment, the metrics' record round trip, and a real comparison's fields.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -152,17 +153,24 @@ TEST(EventAlignment, MetricsRoundTripAndOldRecordsLoad) {
   m.first_wrong_event = "reference: surface:stem at t=4.638, engine: none";
   m.events_not_compared = "stick 1 (reference)";
   m.event_min_dwell = 0.0039;
+  m.event_alignment = {{"match", "inversion", "inversion", 4.328, 4.2},
+                       {"missing", "surface:stem", "", 4.638, std::nullopt},
+                       {"extra", "", "surface:none", std::nullopt, 4.7}};
+  m.event_alignment_rows = 3;
   const json j = to_json(m);
   const Metrics back = metrics_from_json(json::parse(j.dump()));
   EXPECT_EQ(to_json(back), j);
   EXPECT_EQ(back.first_wrong_event, m.first_wrong_event);
   EXPECT_EQ(*back.events_matched, 3);
+  ASSERT_EQ(back.event_alignment.size(), 3u);
+  EXPECT_EQ(back.event_alignment[1].reference_kind, "surface:stem");
+  EXPECT_FALSE(back.event_alignment[1].engine_time.has_value());
 
   // A record written before the alignment: the fields are absent and read as absent.
   json old = j;
   for (const char* k : {"events_reference", "events_engine", "events_matched", "events_missing", "events_extra",
                         "event_time_max_error", "first_wrong_event_index", "first_wrong_event", "events_not_compared",
-                        "event_min_dwell"})
+                        "event_min_dwell", "event_alignment", "event_alignment_rows"})
     old.erase(k);
   const Metrics o = metrics_from_json(old);
   EXPECT_FALSE(o.events_matched.has_value());
@@ -178,6 +186,9 @@ TEST(EventAlignment, MetricsRoundTripAndOldRecordsLoad) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("metrics.events_missing"), std::string::npos) << e.what();
   }
+  bad = j;
+  bad["event_alignment"][0]["op"] = "swap";
+  EXPECT_THROW(metrics_from_json(bad), std::invalid_argument);
   bad = j;
   bad["first_wrong_event_index"] = nullptr;
   EXPECT_THROW(metrics_from_json(bad), std::invalid_argument);
@@ -214,6 +225,12 @@ TEST(EventAlignment, ShippedSceneComparisonCarriesConsistentFields) {
     EXPECT_EQ(wrong, m.at("first_wrong_event_index").is_number_integer()) << name;
     if (wrong) {
       EXPECT_EQ(m.at("first_wrong_event").get<std::string>().rfind("reference: ", 0), 0u) << name;
+    }
+    // The rows the record keeps agree with the counts and the first wrong event.
+    const json& rows = m.at("event_alignment");
+    EXPECT_EQ(static_cast<long long>(rows.size()), std::min<long long>(m.at("event_alignment_rows").get<long long>(), 20)) << name;
+    if (wrong && m.at("first_wrong_event_index").get<long long>() < static_cast<long long>(rows.size())) {
+      EXPECT_NE(rows.at(m.at("first_wrong_event_index").get<size_t>()).at("op"), "match") << name;
     }
     // The reference's contact-law events are said to be left out, not counted as missing.
     EXPECT_NE(m.at("events_not_compared").get<std::string>().find("impact"), std::string::npos) << name;
