@@ -72,16 +72,18 @@ TEST(EventAlignment, SubstitutionCountsOneMissingAndOneExtra) {
 }
 
 TEST(EventAlignment, TimeErrorsOfMatchedEventsAndTheirTieBreak) {
-  // Both engine inversions could pair with the reference's by kind alone: the alignment pairs
-  // the nearer one (ties in edit count are broken by the matched time errors).
+  // Both engine "surface:ball" events could pair with the reference's by kind alone: the
+  // alignment pairs the nearer one, the first (ties in edit count are broken by the matched time
+  // errors; the trace back alone would take the last).
   const EventAlignment a = align_events(seq({{"surface:both", 2.0}, {"surface:ball", 3.0}}),
-                                        seq({{"surface:both", 2.25}, {"surface:ball", 2.5}, {"surface:ball", 2.9}}));
+                                        seq({{"surface:both", 2.25}, {"surface:ball", 2.95}, {"surface:ball", 3.5}}));
   EXPECT_EQ(a.matched, 2);
   EXPECT_EQ(a.extra, 1);
   EXPECT_DOUBLE_EQ(a.time_max_error, 0.25);
   ASSERT_EQ(a.pairs.size(), 3u);
-  EXPECT_EQ(a.pairs[1].op, AlignOp::Extra);
-  EXPECT_EQ(*a.pairs[2].engine, 2u);
+  EXPECT_EQ(a.pairs[1].op, AlignOp::Match);
+  EXPECT_EQ(*a.pairs[1].engine, 1u);
+  EXPECT_EQ(a.pairs[2].op, AlignOp::Extra);
 }
 
 TEST(EventAlignment, EmptySides) {
