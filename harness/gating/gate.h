@@ -24,6 +24,8 @@ struct Check {
   std::vector<std::string> overrides;  // what load_scene gets: run.duration=... first, then `set`
   std::string status = "ok";           // required run status
   bool require_same_events = false;
+  // The aligned event sequences (measure/event_alignment.h) may have no first wrong event.
+  bool require_no_wrong_event = false;
   // Whether a threshold may be judged on the reference's converged window when that ends before
   // the check's duration (the reference's self-check, compare.h). false: such a row fails.
   bool allow_unconverged = false;
@@ -45,6 +47,7 @@ struct GateFile {
 //    the gate file), engine (a registered engine), set (array of "KEY=VALUE" strings), duration
 //    (number > 0, overrides run.duration), status (a run status: ok, contact_lost, diverged,
 //    unphysical, clamped, failed; default ok), require_same_events (boolean, default false),
+//    require_no_wrong_event (boolean, default false),
 //    max (table: gate metric -> finite number >= 0), allow_unconverged (boolean, default false).
 //  - [defaults] takes every check key but name; a check's own scalar wins, its `set` follows
 //    the defaults' (later overrides win), its `max` entries replace the defaults' per metric.
@@ -55,7 +58,8 @@ GateFile load_gate_file(const std::string& path);
 
 // ---- evaluation -----------------------------------------------------------------------------
 
-// One line of a check's verdict: the run status, an event pairing, or one threshold.
+// One line of a check's verdict: the run status, an event pairing or the aligned sequences
+// ("first_wrong_event"), or one threshold.
 enum class GateRowKind { Status, Events, Threshold, Error };
 struct GateRow {
   GateRowKind kind = GateRowKind::Threshold;

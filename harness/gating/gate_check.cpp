@@ -37,6 +37,8 @@ std::string absent_reason(const std::string& metric, const Metrics& m) {
     return m.inversion_event + ": " + event_story(m.inversion_event, "inverts", "inversion");
   if (metric.rfind("stem_contact_", 0) == 0)
     return m.stem_contact_event + ": " + event_story(m.stem_contact_event, "reaches stem contact", "stem contact");
+  if (metric == "event_time_max_error" || metric == "events_missing" || metric == "events_extra")
+    return "a record written before the event sequences were aligned";
   if (metric == "jellett_drift_ball") return "the engine never rolled on the ball";
   if (metric == "jellett_drift_stem") return "the engine never rolled on the stem";
   return "not computed";
@@ -82,6 +84,27 @@ GateRow event_row(const std::string& metric, const std::string& which, const cha
   return r;
 }
 
+// require_no_wrong_event: the aligned event sequences (measure/event_alignment.h) have no first
+// wrong event. A record without the alignment fails: nothing was compared.
+GateRow wrong_event_row(const Metrics& m) {
+  GateRow r;
+  r.kind = GateRowKind::Events;
+  r.metric = "first_wrong_event";
+  r.required = "none";
+  if (!m.events_matched) {
+    r.measured = "absent";
+    r.message = "first_wrong_event: absent (the event sequences were not aligned)";
+    return r;
+  }
+  r.measured = m.first_wrong_event.empty() ? "none" : m.first_wrong_event;
+  r.passed = m.first_wrong_event.empty();
+  if (!r.passed)
+    r.message = "first_wrong_event at aligned event " + std::to_string(m.first_wrong_event_index.value_or(-1)) + ": " +
+                m.first_wrong_event + " (" + std::to_string(m.events_missing.value_or(0)) + " missing, " +
+                std::to_string(m.events_extra.value_or(0)) + " extra)";
+  return r;
+}
+
 }  // namespace
 
 GateRow threshold_row(const Threshold& t, const Metrics& m) {
@@ -116,7 +139,10 @@ namespace {
 bool windowed_metric(const std::string& metric) {
   static const std::set<std::string> names = {"tilt_max_error",         "tilt_rms_error",         "energy_max_error",
                                               "contact_path_rms_error", "contact_path_max_error", "com_path_rms_error",
-                                              "com_path_max_error",     "latitude_rms_error",     "compared_until"};
+                                              "com_path_max_error",     "latitude_rms_error",     "compared_until",
+                                              // the event alignment leaves out events after the window
+                                              "event_time_max_error",   "events_missing",         "events_extra",
+                                              "first_wrong_event"};
   return names.count(metric) > 0;
 }
 
@@ -141,7 +167,10 @@ void mark_unconverged(std::vector<GateRow>& rows, const Check& check, const Metr
                           short_value(check.loaded.run.duration) + ")";
   for (GateRow& row : rows) {
     std::string which;
-    const bool event = row.kind == GateRowKind::Events || (row.kind == GateRowKind::Threshold && event_metric(row.metric, &which, m));
+    // The aligned sequences are windowed like the sample metrics, not an event pairing.
+    const bool aligned = row.metric == "first_wrong_event";
+    const bool event = (row.kind == GateRowKind::Events && !aligned) ||
+                       (row.kind == GateRowKind::Threshold && event_metric(row.metric, &which, m));
     if (row.kind == GateRowKind::Events) which = row.measured;
     if (event) {
       if (which != "unconverged") continue;  // the pairing was judged inside the window
@@ -150,7 +179,7 @@ void mark_unconverged(std::vector<GateRow>& rows, const Check& check, const Metr
       row.message = row.passed ? "" : row.metric + ": " + why + "; the event is not judged";
       continue;
     }
-    if (row.kind != GateRowKind::Threshold || !windowed_metric(row.metric)) continue;
+    if ((row.kind != GateRowKind::Threshold && !aligned) || !windowed_metric(row.metric)) continue;
     row.measured += " compared to t = " + x + " (reference converged)";
     if (check.allow_unconverged) continue;  // judged on the window, and marked
     row.passed = false;
@@ -213,6 +242,7 @@ CheckResult evaluate_check(const Check& check, const RunRecord& reference, const
     r.rows.push_back(event_row("inversion_event", metrics.inversion_event, "inverts", "inversion"));
     r.rows.push_back(event_row("stem_contact_event", metrics.stem_contact_event, "reaches stem contact", "stem contact"));
   }
+  if (check.require_no_wrong_event) r.rows.push_back(wrong_event_row(metrics));
   for (const Threshold& t : check.max) r.rows.push_back(threshold_row(t, metrics));
   mark_unconverged(r.rows, check, metrics);
   r.passed = rows_pass(r.rows);

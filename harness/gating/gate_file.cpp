@@ -76,6 +76,7 @@ struct Spec {
   std::optional<std::vector<std::string>> set;
   std::optional<double> duration;
   std::optional<bool> require_same_events;
+  std::optional<bool> require_no_wrong_event;
   std::optional<bool> allow_unconverged;
   std::map<std::string, double> max;
 };
@@ -86,10 +87,10 @@ class GateReader : public TomlReader {
 
   Spec spec(const toml::table& t, const std::string& key, bool is_defaults) const {
     static const std::vector<std::string> check_keys = {"name",   "scene", "engine", "set", "duration",
-                                                        "status", "require_same_events", "allow_unconverged",
+                                                        "status", "require_same_events", "require_no_wrong_event", "allow_unconverged",
                                                         "max"};
     static const std::vector<std::string> default_keys = {"scene",  "engine", "set", "duration",
-                                                          "status", "require_same_events", "allow_unconverged",
+                                                          "status", "require_same_events", "require_no_wrong_event", "allow_unconverged",
                                                           "max"};
     keys(t, key, is_defaults ? default_keys : check_keys);
     Spec s;
@@ -119,6 +120,11 @@ class GateReader : public TomlReader {
       const auto* b = n->as_boolean();
       if (!b) fail(key + ".require_same_events", "expected true or false, got " + toml_value_text(*n));
       s.require_same_events = b->get();
+    }
+    if (const toml::node* n = t.get("require_no_wrong_event")) {
+      const auto* b = n->as_boolean();
+      if (!b) fail(key + ".require_no_wrong_event", "expected true or false, got " + toml_value_text(*n));
+      s.require_no_wrong_event = b->get();
     }
     if (const toml::node* n = t.get("allow_unconverged")) {
       const auto* b = n->as_boolean();
@@ -221,6 +227,8 @@ GateFile load_gate_file(const std::string& path) {
     c.engine = s.engine ? *s.engine : *defaults.engine;
     c.status = s.status ? *s.status : defaults.status.value_or("ok");
     c.require_same_events = s.require_same_events ? *s.require_same_events : defaults.require_same_events.value_or(false);
+    c.require_no_wrong_event =
+        s.require_no_wrong_event ? *s.require_no_wrong_event : defaults.require_no_wrong_event.value_or(false);
     c.allow_unconverged = s.allow_unconverged ? *s.allow_unconverged : defaults.allow_unconverged.value_or(false);
     c.duration = s.duration ? s.duration : defaults.duration;
     const std::string duration_key = origin(s, defaults, s.duration.has_value(), "duration");

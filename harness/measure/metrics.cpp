@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include "io/json_fields.h"
+#include "measure/event_alignment.h"
 
 namespace tippe {
 
@@ -157,6 +158,37 @@ Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, con
                   m.stem_contact_time_abs_error, m.stem_contact_time_rel_error);
   else
     m.stem_contact_event = "unconverged";
+
+  {
+    // The event sequences, aligned over the reference's converged window (all of it when
+    // unchecked). The dwell is a time of the top's own scale (event_alignment.h); a scene without
+    // one (synthetic) merges nothing.
+    const double scale = std::sqrt(scene.body.sphere_radius / scene.gravity);
+    const double dwell = std::isfinite(scale) && scale > 0 ? kEventMinDwellFraction * scale : 0.0;
+    const double until = converged_until ? *converged_until : std::numeric_limits<double>::infinity();
+    const CanonicalSequence ref_seq = canonical_events(reference.events, dwell, until);
+    const CanonicalSequence eng_seq = canonical_events(engine.events, dwell, until);
+    const EventAlignment a = align_events(ref_seq.events, eng_seq.events);
+    m.events_reference = static_cast<long long>(a.reference.size());
+    m.events_engine = static_cast<long long>(a.engine.size());
+    m.events_matched = a.matched;
+    m.events_missing = a.missing;
+    m.events_extra = a.extra;
+    m.event_time_max_error = a.time_max_error;
+    if (a.first_wrong) m.first_wrong_event_index = static_cast<long long>(*a.first_wrong);
+    m.first_wrong_event = a.first_wrong_text;
+    m.events_not_compared = not_compared_text(ref_seq, eng_seq);
+    m.event_min_dwell = dwell;
+    m.event_alignment_rows = static_cast<long long>(a.pairs.size());
+    for (size_t k = 0; k < a.pairs.size() && k < kMaxAlignedEventRowsKept; ++k) {
+      const AlignedPair& p = a.pairs[k];
+      AlignedEventRow row;
+      row.op = to_string(p.op);
+      if (p.reference) row.reference_kind = a.reference[*p.reference].kind, row.reference_time = a.reference[*p.reference].time;
+      if (p.engine) row.engine_kind = a.engine[*p.engine].kind, row.engine_time = a.engine[*p.engine].time;
+      m.event_alignment.push_back(std::move(row));
+    }
+  }
 
   const double R = scene.body.sphere_radius;
   const double E0_ref = ref_traj.size() ? ref_traj.energy.front() : reference.energy_initial;

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 #include <set>
+#include <tuple>
 #include <stdexcept>
 #include "io/json_fields.h"
 #include "io/scene_io.h"
@@ -15,7 +16,85 @@ namespace tippe {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+namespace {
+
+json count(const std::optional<long long>& v) { return v ? json(*v) : json(nullptr); }
+
+// The event alignment's fields, absent in records written before it existed: read as absent.
+// Present, each is checked (a count >= 0, a time >= 0, a string or null).
+void read_event_alignment(const json& j, Metrics& m) {
+  auto optional_count = [&](const char* key, std::optional<long long>& out) {
+    if (!j.contains(key) || j.at(key).is_null()) return;
+    const json& v = j.at(key);
+    if (!v.is_number_integer() || v.get<long long>() < 0)
+      throw std::invalid_argument(std::string("metrics.") + key + ": " + v.dump() + " is not a count >= 0 or null");
+    out = v.get<long long>();
+  };
+  auto optional_time = [&](const char* key, std::optional<double>& out) {
+    if (!j.contains(key) || j.at(key).is_null()) return;
+    const json& v = j.at(key);
+    if (!v.is_number() || !(std::isfinite(v.get<double>()) && v.get<double>() >= 0))
+      throw std::invalid_argument(std::string("metrics.") + key + ": " + v.dump() + " is not a time >= 0 or null");
+    out = v.get<double>();
+  };
+  auto optional_text = [&](const char* key, std::string& out) {
+    if (!j.contains(key) || j.at(key).is_null()) return;
+    if (!j.at(key).is_string())
+      throw std::invalid_argument(std::string("metrics.") + key + ": " + j.at(key).dump() + " is not a string or null");
+    out = j.at(key).get<std::string>();
+  };
+  optional_count("events_reference", m.events_reference);
+  optional_count("events_engine", m.events_engine);
+  optional_count("events_matched", m.events_matched);
+  optional_count("events_missing", m.events_missing);
+  optional_count("events_extra", m.events_extra);
+  optional_time("event_time_max_error", m.event_time_max_error);
+  optional_count("first_wrong_event_index", m.first_wrong_event_index);
+  optional_text("first_wrong_event", m.first_wrong_event);
+  optional_text("events_not_compared", m.events_not_compared);
+  optional_time("event_min_dwell", m.event_min_dwell);
+  optional_count("event_alignment_rows", m.event_alignment_rows);
+  if (j.contains("event_alignment") && !j.at("event_alignment").is_null()) {
+    const json& rows = j.at("event_alignment");
+    if (!rows.is_array()) throw std::invalid_argument("metrics.event_alignment: " + rows.dump() + " is not an array");
+    static const std::set<std::string> ops = {"match", "substitution", "missing", "extra"};
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const json& r = rows.at(i);
+      const std::string where = "metrics.event_alignment[" + std::to_string(i) + "]";
+      if (!r.is_object() || !r.contains("op") || !r.at("op").is_string() || !ops.count(r.at("op").get<std::string>()))
+        throw std::invalid_argument(where + ".op: expected one of match, substitution, missing, extra");
+      AlignedEventRow row;
+      row.op = r.at("op").get<std::string>();
+      for (const auto& [side, kind, time] : {std::tuple<const char*, std::string*, std::optional<double>*>{
+                                                 "reference", &row.reference_kind, &row.reference_time},
+                                             {"engine", &row.engine_kind, &row.engine_time}}) {
+        const std::string tkey = std::string("t_") + side;
+        if (r.contains(side) && !r.at(side).is_null()) {
+          if (!r.at(side).is_string()) throw std::invalid_argument(where + "." + side + ": not a string or null");
+          *kind = r.at(side).get<std::string>();
+        }
+        if (r.contains(tkey) && !r.at(tkey).is_null()) {
+          if (!r.at(tkey).is_number()) throw std::invalid_argument(where + "." + tkey + ": not a number or null");
+          *time = r.at(tkey).get<double>();
+        }
+      }
+      m.event_alignment.push_back(std::move(row));
+    }
+  }
+  if (m.first_wrong_event_index.has_value() == m.first_wrong_event.empty())
+    throw std::invalid_argument("metrics.first_wrong_event: present without first_wrong_event_index, or the reverse");
+}
+
+}  // namespace
+
 json to_json(const Metrics& m) {
+  json rows = json::array();
+  for (const AlignedEventRow& r : m.event_alignment)
+    rows.push_back({{"op", r.op},
+                    {"reference", r.reference_kind.empty() ? json(nullptr) : json(r.reference_kind)},
+                    {"t_reference", number(r.reference_time)},
+                    {"engine", r.engine_kind.empty() ? json(nullptr) : json(r.engine_kind)},
+                    {"t_engine", number(r.engine_time)}});
   return json{
       {"inversion_event", m.inversion_event},
       {"inversion_time_abs_error", number(m.inversion_time_abs_error)},
@@ -44,6 +123,18 @@ json to_json(const Metrics& m) {
       {"cost_ratio", number(m.cost_ratio)},
       {"compared_until", number(m.compared_until)},
       {"reference_converged_until", number(m.reference_converged_until)},
+      {"events_reference", count(m.events_reference)},
+      {"events_engine", count(m.events_engine)},
+      {"events_matched", count(m.events_matched)},
+      {"events_missing", count(m.events_missing)},
+      {"events_extra", count(m.events_extra)},
+      {"event_time_max_error", number(m.event_time_max_error)},
+      {"first_wrong_event_index", count(m.first_wrong_event_index)},
+      {"first_wrong_event", m.first_wrong_event.empty() ? json(nullptr) : json(m.first_wrong_event)},
+      {"events_not_compared", m.events_not_compared},
+      {"event_min_dwell", number(m.event_min_dwell)},
+      {"event_alignment", rows},
+      {"event_alignment_rows", count(m.event_alignment_rows)},
   };
 }
 
@@ -85,6 +176,7 @@ Metrics metrics_from_json(const json& j) {
       m.reference_converged_until = t;
     }
   }
+  read_event_alignment(j, m);
   return m;
 }
 

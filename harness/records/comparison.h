@@ -11,6 +11,18 @@
 
 namespace tippe {
 
+// One row of the aligned event sequences (measure/event_alignment.h): "match", "substitution",
+// "missing" (the reference's only) or "extra" (the engine's only); a side without an event there
+// has an empty kind and no time.
+struct AlignedEventRow {
+  std::string op;
+  std::string reference_kind, engine_kind;
+  std::optional<double> reference_time, engine_time;
+};
+// The rows a record keeps of an alignment (the first ones; the counts are of all of them): the
+// report shows them, and a sweep's records.jsonl carries them on every line.
+inline constexpr size_t kMaxAlignedEventRowsKept = 20;
+
 // Metrics of one engine against the reference. Event metrics: an event one side has and the
 // other lacks is a finding: `*_event` says which ("both", "neither", "engine_only",
 // "reference_only") and the errors are then absent (null in JSON).
@@ -35,6 +47,18 @@ struct Metrics {
   // The end of the reference's converged window (SelfCheck::converged_until) when the metrics
   // against the reference stop there; absent: compared over the whole common grid.
   std::optional<double> reference_converged_until;
+  // The event sequences aligned (measure/event_alignment.h: the canonical vocabulary, what is
+  // left out and why). Absent (null in JSON) in records written before the alignment existed.
+  std::optional<long long> events_reference;  // canonical events of the reference in the window
+  std::optional<long long> events_engine;     // ... of the engine
+  std::optional<long long> events_matched, events_missing, events_extra;  // matched + missing = events_reference
+  std::optional<double> event_time_max_error;  // s, largest |t_engine - t_ref| of matched events (0: none matched)
+  std::optional<long long> first_wrong_event_index;  // index in the aligned pairs; absent: none wrong
+  std::string first_wrong_event;  // "reference: X at t=.., engine: Y at t=.."; "" when none is wrong
+  std::string events_not_compared;  // events left out of the comparison, counted ("stick 1 (reference)")
+  std::optional<double> event_min_dwell;  // s: surface phases shorter than this merged (a bench setting)
+  std::vector<AlignedEventRow> event_alignment;  // the first kMaxAlignedEventRowsKept aligned pairs
+  std::optional<long long> event_alignment_rows;  // how many pairs the whole alignment has
 };
 
 nlohmann::json to_json(const Metrics& m);

@@ -37,6 +37,9 @@ const std::vector<GateMetric>& gate_metrics() {
       TIPPE_GATE_VALUE(steps, "engine steps"),
       TIPPE_GATE_VALUE(cost_ratio, "engine CPU / reference CPU"),
       TIPPE_GATE_VALUE(compared_until, "s"),
+      TIPPE_GATE_OPTIONAL(event_time_max_error, "s, largest over matched events (measure/event_alignment.h)"),
+      TIPPE_GATE_OPTIONAL(events_missing, "reference events the engine lacks (count)"),
+      TIPPE_GATE_OPTIONAL(events_extra, "engine events the reference lacks (count)"),
   };
   return table;
 }
@@ -53,6 +56,8 @@ const GateMetric* find_gate_metric(const std::string& name) {
 std::string gate_metric_problem(const std::string& metric) {
   if (metric == "wall_seconds" || metric == "cpu_seconds" || metric == "real_time_factor")
     return "timing is never gated (it depends on the machine and its load); bound steps or cost_ratio";
+  if (metric == "first_wrong_event")
+    return "not a number: require the aligned event sequences to agree with require_no_wrong_event = true";
   if (!find_gate_metric(metric)) {
     std::vector<std::string> names;
     for (const auto& g : gate_metrics()) names.emplace_back(g.name);

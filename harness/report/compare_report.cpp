@@ -12,6 +12,7 @@
 
 #include "measure/compare.h"
 #include "records/records.h"
+#include "report/compare_events.h"
 #include "report/report_text.h"
 
 namespace tippe {
@@ -414,6 +415,7 @@ Document comparison_document(const json& c, const std::vector<std::string>& plot
              "the comparison carries tolerances.",
          "note");
   d.table(doc_table(detail_table(c), "detail"), "More metrics", true);
+  add_event_sequences(d, c);
 
   d.heading(2, "Findings");
   const auto findings = report_findings(c);

@@ -223,7 +223,12 @@ TEST(GateMetrics, AreTheNumericMetricsButWallClock) {
   const json all = to_json(Metrics{});
   for (const auto& [k, v] : all.items())
     if (!v.is_string() && k != "wall_seconds" && k != "cpu_seconds" && k != "real_time_factor" &&
-        k != "reference_converged_until")  // the reference's, not the engine's: it marks rows instead
+        k != "reference_converged_until" &&  // the reference's, not the engine's: it marks rows instead
+        // The event alignment: its counts of events on each side and of matches describe the
+        // sequences (missing and extra judge them), the first wrong event is a text gated by
+        // require_no_wrong_event, the dwell is a setting of the bench.
+        k != "events_reference" && k != "events_engine" && k != "events_matched" && k != "first_wrong_event" &&
+        k != "first_wrong_event_index" && k != "event_min_dwell" && k != "event_alignment" && k != "event_alignment_rows")
       expected.insert(k);
   std::set<std::string> names;
   for (const GateMetric& g : gate_metrics()) EXPECT_TRUE(names.insert(g.name).second) << g.name << " listed twice";
@@ -236,7 +241,13 @@ TEST(GateMetrics, EachAccessorReadsItsOwnField) {
   json j = to_json(Metrics{});
   double v = 1.0;
   for (auto& [k, x] : j.items())
-    if (!x.is_string()) x = (k == "steps" || k == "energy_gain_events") ? json(static_cast<long long>(v++)) : json(v++ + 0.5);
+    if (k == "first_wrong_event") x = "reference: inversion at t=1, engine: none";
+    else if (x.is_array()) continue;  // the aligned rows, no gate metric
+    else if (!x.is_string())
+      x = (k == "steps" || k == "energy_gain_events" || k.rfind("events_", 0) == 0 || k == "first_wrong_event_index" ||
+               k == "event_alignment_rows")
+              ? json(static_cast<long long>(v++))
+              : json(v++ + 0.5);
   const Metrics m = metrics_from_json(j);
   for (const GateMetric& g : gate_metrics()) {
     const auto got = g.get(m);
@@ -849,4 +860,99 @@ allow_unconverged = false
   } catch (const SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("check[0].allow_unconverged: expected true or false"), std::string::npos) << e.what();
   }
+}
+
+// ---- the aligned event sequences (measure/event_alignment.h) --------------------------------------
+
+TEST(GateEvaluate, EventTimeBoundPassesAndFails) {
+  Check c = fixture_check();
+  c.max = {{"event_time_max_error", 0.05}};
+  Metrics m = fixture_metrics();
+  m.events_reference = 2, m.events_engine = 2, m.events_matched = 2, m.events_missing = 0, m.events_extra = 0;
+  m.event_time_max_error = 0.04;
+  CheckResult r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.29), m);
+  EXPECT_TRUE(r.passed) << row(r, "event_time_max_error")->message;
+  m.event_time_max_error = 0.06;
+  r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.31), m);
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(row(r, "event_time_max_error")->message, "event_time_max_error 0.06 > 0.05");
+  // A record without the alignment fails the bound with the reason, never passes it.
+  m.event_time_max_error.reset();
+  r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.31), m);
+  EXPECT_FALSE(r.passed);
+  EXPECT_NE(row(r, "event_time_max_error")->message.find("before the event sequences were aligned"), std::string::npos);
+}
+
+TEST(GateEvaluate, RequireNoWrongEvent) {
+  Check c = fixture_check();
+  c.max.clear();
+  c.require_no_wrong_event = true;
+  Metrics m = fixture_metrics();
+  m.events_reference = 2, m.events_engine = 2, m.events_matched = 2, m.events_missing = 0, m.events_extra = 0;
+  m.event_time_max_error = 0.01;
+  CheckResult r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.3), m);
+  EXPECT_TRUE(r.passed);
+  ASSERT_NE(row(r, "first_wrong_event"), nullptr);
+  EXPECT_EQ(row(r, "first_wrong_event")->measured, "none");
+
+  m.events_matched = 1, m.events_missing = 1, m.events_extra = 1;
+  m.first_wrong_event_index = 1;
+  m.first_wrong_event = "reference: stem_contact at t=1.23, engine: inversion at t=1.1";
+  r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.3), m);
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(row(r, "first_wrong_event")->message,
+            "first_wrong_event at aligned event 1: reference: stem_contact at t=1.23, engine: inversion at t=1.1 "
+            "(1 missing, 1 extra)");
+  // Not aligned (an older record): nothing was compared, so it fails.
+  r = evaluate_check(c, fixture_record("analytic", 17.25), fixture_record("ode", 17.3), fixture_metrics());
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(row(r, "first_wrong_event")->measured, "absent");
+}
+
+TEST(GateFile, EventKeysParsedWithClearErrors) {
+  TempDir d{"tippe-gate"};
+  d.write("fixture.toml", slurp(kSource + "/harness/scenes/toy.toml"));
+  const GateFile g = load_gate_file(d.write("g.toml", R"(
+[defaults]
+scene = "fixture.toml"
+engine = "ode"
+require_no_wrong_event = true
+[[check]]
+name = "a"
+[check.max]
+event_time_max_error = 0.01
+events_missing = 0
+[[check]]
+name = "b"
+require_no_wrong_event = false
+)"));
+  ASSERT_EQ(g.checks.size(), 2u);
+  EXPECT_TRUE(g.checks[0].require_no_wrong_event);
+  EXPECT_FALSE(g.checks[1].require_no_wrong_event);
+  ASSERT_EQ(g.checks[0].max.size(), 2u);
+  const std::string head = "[[check]]\nname = \"a\"\nscene = \"fixture.toml\"\nengine = \"ode\"\n";
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {head + "require_no_wrong_event = \"yes\"\n", "check[0].require_no_wrong_event: expected true or false"},
+      {head + "[check.max]\nevent_time_max_error = -1\n", "check[0].max.event_time_max_error"},
+      {head + "[check.max]\nfirst_wrong_event = 0\n", "check[0].max.first_wrong_event: not a number: require"},
+  };
+  for (const auto& [text, expected] : bad) {
+    try {
+      load_gate_file(d.write("bad.toml", text));
+      ADD_FAILURE() << "loaded: " << text;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bad.toml"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(GateCommand, BadEventBoundExits2) {
+  TempDir d{"tippe-gate"};
+  d.write("fixture.toml", slurp(kSource + "/harness/scenes/toy.toml"));
+  const std::string gate = d.write("g.toml", "[[check]]\nname = \"a\"\nscene = \"fixture.toml\"\nengine = \"ode\"\n"
+                                             "[check.max]\nevent_time_max_error = \"small\"\n");
+  const Exit e = run_tippe("gate " + gate, d.path());
+  EXPECT_EQ(e.code, 2) << e.err;
+  EXPECT_NE(e.err.find("check[0].max.event_time_max_error"), std::string::npos) << e.err;
 }
