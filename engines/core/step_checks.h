@@ -19,7 +19,20 @@ struct ContactReport {
   double normal_force_stem = 0.0;  // ... on the stem geom
   bool point_valid = false;
   Vec3 p_WC = Vec3::Zero();        // engine's contact point (force-weighted mean when several)
+  // Per surface, the friction force on the top (lab frame) and the F_n-weighted point: filled by
+  // add_surface_force and finish_surface_points, read by contact_forces().
+  Vec3 friction_ball_W = Vec3::Zero(), friction_stem_W = Vec3::Zero();
+  Vec3 p_WC_ball = Vec3::Zero(), p_WC_stem = Vec3::Zero();
+  double weight_ball = 0.0, weight_stem = 0.0;  // the positive F_n summed into each point
 };
+
+// Adds one engine contact point's friction force and its point to the per-surface fields of r (the
+// normal sums, flags and mean point are the adapter's own, unchanged); finish_surface_points
+// turns the weighted sums into points once every point is in.
+void add_surface_force(ContactReport& r, bool stem, double f_n, const Vec3& f_t_W, const Vec3& p_W);
+void finish_surface_points(ContactReport& r);
+// The report as the simulator interface carries it.
+EngineContactForces contact_forces(const ContactReport& r);
 
 // Limits that turn a run into a result instead of a crash (issue: failures are results).
 struct FailureLimits {
