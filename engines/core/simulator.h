@@ -97,6 +97,10 @@ class Simulator {
   // The contact forces of the last step (of the initial state before the first): an adapter
   // supplies what its engine computed; the default is a simulator that reports none.
   virtual EngineContactForces contact_forces() const { return {}; }
+  // The work of the friction forces of contact_forces() over the run so far: per step, F_t . v_C
+  // times the step at each surface, v_C the velocity of the top's material point at the force's
+  // point at the end of the step. NaN where the simulator reports no contact forces.
+  virtual double friction_work() const;
   // Notes on approximations in force (e.g. "rolling approximated by mu = 1e3").
   virtual std::vector<std::string> notes() const { return {}; }
 };

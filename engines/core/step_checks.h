@@ -76,6 +76,8 @@ class StepChecks {
   const std::vector<Event>& events() const { return events_; }
   // The state the last accepted step ended in (or the start's, or set_state's).
   const BodyState& last_state() const { return last_.state; }
+  // The friction work of the steps so far (Simulator::friction_work).
+  double friction_work() const { return friction_work_; }
 
  private:
   struct StepProbe {
@@ -83,6 +85,7 @@ class StepChecks {
     double cos_theta = 1.0, gap_ball = 0.0, gap_stem = 0.0;
   };
   StepProbe probe(const BodyState& x) const;
+  void add_friction_work(const BodyState& y, double h, const ContactReport& c);
   void track_events(const StepProbe& before, const StepProbe& after, const ContactReport& c);
 
   BodyModel body_;
@@ -94,6 +97,7 @@ class StepChecks {
   std::vector<Event> events_;
   StepProbe last_;
   bool inverted_ = false, stem_touched_ = false;
+  double friction_work_ = 0.0;
   Surface contact_surface_ = Surface::Ball;
 };
 
@@ -113,6 +117,7 @@ class CheckedSimulator : public Simulator {
   std::string status_detail() const override { return checks_.status_detail(); }
   std::vector<Event> events() const override { return checks_.events(); }
   size_t event_count() const override { return checks_.events().size(); }
+  double friction_work() const override { return checks_.friction_work(); }
 
  protected:
   explicit CheckedSimulator(const Scene& scene) : checks_(BodyModel::from_scene(scene)) {}
