@@ -131,10 +131,11 @@ TEST_P(ContactForcesTest, SlidingBallCarriesItsWeightAtEverySample) {
   EXPECT_EQ(r.with_force, r.samples) << row().engine << ": the sliding ball leaves the floor";
 }
 
-// MuJoCo 2.2 (defaults: RK4, elliptic cone, solref 0.02 1): its convex soft contact pushes a
-// slipping ball off the floor ("the only way to initiate slip is to generate some motion in the
-// normal direction", MuJoCo's documentation): F_n > 0 at 4 of 700 samples (measured), the ball
-// hops. At those 4, |F_t| = mu F_n to round-off and opposes the slip, as the test above checks.
+// MuJoCo 2.2 (the adapter's defaults: RK4, elliptic cone, solref 0.002 1): its convex soft
+// contact pushes a slipping ball off the floor ("the only way to initiate slip is to generate
+// some motion in the normal direction", MuJoCo's documentation): F_n > 0 at 4 of 700 samples
+// (measured), the ball hops. At those 4, |F_t| = mu F_n to round-off and opposes the slip, as
+// SlidingBallFeelsCoulombFrictionAgainstItsSlip checks.
 TEST(ContactForcesKnown, DISABLED_MujocoSlidingBallCarriesItsWeight) {
   const SlideSamples r = sample_slide("mujoco");
   EXPECT_EQ(r.with_force, r.samples) << "mujoco: the sliding ball leaves the floor";
