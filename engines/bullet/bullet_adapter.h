@@ -111,6 +111,9 @@ struct ContactSum {
   double impulse_ball = 0.0, impulse_stem = 0.0;  // the parts of impulse on each geom
   Vec3 moment = Vec3::Zero();
   double max_point_impulse = 0.0;  // in Bullet's units (its spinning-friction cap is there)
+  // The per-surface friction impulses on the top (lab frame) and points (add_surface_force, with
+  // impulses for forces: divided by dt when the step's report is made).
+  ContactReport surfaces;
 };
 
 }  // namespace bullet_detail

@@ -49,6 +49,14 @@ void BulletSimulator::collect_contacts(ContactSum& sum) const {
         sum.moment += P * to_eigen(p_W);
         sum.max_point_impulse = std::max(sum.max_point_impulse, P_bt);
       }
+      // The solver's lateral impulses along the point's friction directions act on body 0 (on
+      // body 1 opposite), as its normal impulse along m_normalWorldOnB; the second direction is
+      // solved (and written back) only with two friction directions.
+      btVector3 lateral = cp.m_appliedImpulseLateral1 * cp.m_lateralFrictionDir1;
+      if (settings_.friction_directions == 2) lateral += cp.m_appliedImpulseLateral2 * cp.m_lateralFrictionDir2;
+      const Vec3 lateral_W = to_eigen(lateral) * (settings_.mass_unit * (body_is_0 ? 1.0 : -1.0));
+      const btVector3& q_W = body_is_0 ? cp.getPositionWorldOnB() : cp.getPositionWorldOnA();
+      add_surface_force(sum.surfaces, stem, P, Vec3(lateral_W.x(), lateral_W.y(), 0.0), to_eigen(q_W));
     }
   }
 }

@@ -68,6 +68,14 @@ void BulletSimulator::engine_step() {
     r.point_valid = true;
     r.p_WC = sum.moment / sum.impulse;
   }
+  // The friction impulses of all internal steps over dt: the mean friction force of the step.
+  r.friction_ball_W = sum.surfaces.friction_ball_W / settings_.timestep;
+  r.friction_stem_W = sum.surfaces.friction_stem_W / settings_.timestep;
+  r.p_WC_ball = sum.surfaces.p_WC_ball;
+  r.p_WC_stem = sum.surfaces.p_WC_stem;
+  r.weight_ball = sum.surfaces.weight_ball;
+  r.weight_stem = sum.surfaces.weight_stem;
+  finish_surface_points(r);
   report_ = r;
   // The torsional row's bound is min(mu_d P_n, mu_d) (btSequentialImpulseConstraintSolver caps
   // rollingFrictionMagnitude at m_friction): a unit-dependent cap, reached only when one point's

@@ -33,9 +33,14 @@ BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSp
       out.f_W[out.n] = -contact.mu * f_n * v_C;
     }
     out.r_GC_W[out.n] = R_C;
+    out.stem[out.n] = s == Surface::Stem;
     ++out.n;
   }
   return out;
+}
+
+void add_bench_friction(ContactReport& r, const BenchFrictionForces& f) {
+  for (int i = 0; i < f.n; ++i) (f.stem[i] ? r.friction_stem_W : r.friction_ball_W) += f.f_W[i];
 }
 
 }  // namespace tippe

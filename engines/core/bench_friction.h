@@ -19,6 +19,7 @@ double native_mu(const ContactSpec& contact, double rolling_mu);
 // relative to G in the lab frame.
 struct BenchFrictionForces {
   int n = 0;
+  bool stem[2] = {false, false};  // the surface of each force
   Vec3 f_W[2];
   Vec3 r_GC_W[2];
 };
@@ -34,5 +35,9 @@ struct BenchFrictionForces {
 // step without friction).
 BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSpec& contact, const BodyState& x,
                                           const ContactReport& c);
+
+// Adds the forces f the bench applied over the step to r's per-surface friction forces (the
+// engine's own contact is frictionless under these laws, so they are the friction of the step).
+void add_bench_friction(ContactReport& r, const BenchFrictionForces& f);
 
 }  // namespace tippe

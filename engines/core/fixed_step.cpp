@@ -26,12 +26,19 @@ void FixedStepSimulator::start(double dt) {
 
 Observation FixedStepSimulator::observe() const { return observe_with_contacts(body_, engine_state(), engine_contacts()); }
 
+EngineContactForces FixedStepSimulator::contact_forces() const {
+  ContactReport r = engine_contacts();
+  add_bench_friction(r, bench_applied_);
+  return tippe::contact_forces(r);
+}
+
 void FixedStepSimulator::set_state(const BodyState& x) {
   check_settable_state(engine(), x);
   BodyState y = x;
   y.t = time();
   y.q_WB.normalize();
   engine_set_state(y);
+  bench_applied_.n = 0;
   checks_.restart(engine_state());
 }
 
@@ -82,9 +89,11 @@ void FixedStepSimulator::step_once() {
   // The state the last step ended in, as the per-step checks read it (start and set_state set it
   // too): the engine's state is read once per step, not again here.
   const BodyState& x = checks_.last_state();
+  bench_applied_.n = 0;
   if (bench_applies_friction(scene_.contact.friction)) {
     const BenchFrictionForces f = bench_friction_forces(body_, scene_.contact, x, engine_contacts());
     for (int i = 0; i < f.n; ++i) apply_force_W(f.f_W[i], x.p_WG + f.r_GC_W[i]);
+    bench_applied_ = f;
   }
   engine_step();
   ++n_steps_;
@@ -94,7 +103,10 @@ void FixedStepSimulator::step_once() {
   const double t = static_cast<double>(n_steps_) * dt_;
   const std::string failure = engine_failure();
   if (!failure.empty()) return checks_.fail(RunStatus::Failed, t, failure);
-  if (!checks_.after_step(t, engine_state(), engine_contacts())) return;
+  // The contacts with the bench's friction of the step, for its work (the events read the flags).
+  ContactReport c = engine_contacts();
+  add_bench_friction(c, bench_applied_);
+  if (!checks_.after_step(t, engine_state(), c)) return;
   const std::string limit = engine_limit_hit();
   if (!limit.empty()) return checks_.fail(RunStatus::Clamped, t, limit);
 }

@@ -8,6 +8,7 @@
 #include "../../analytic/initial_state.h"
 #include "registry.h"
 #include "simulator.h"
+#include "bench_friction.h"
 #include "step_checks.h"
 
 namespace tippe {
@@ -26,6 +27,7 @@ class FixedStepSimulator : public CheckedSimulator {
   WorkCounters work() const override { return work_; }
   BodyState state() const override { return engine_state(); }
   void set_state(const BodyState& x) override;
+  EngineContactForces contact_forces() const override;
 
   // Benchmarks only: n engine steps with none of the adapter's work (no events, checks,
   // observations or viscous/gliding forces), to measure the adapter's overhead against the bare engine.
@@ -92,6 +94,8 @@ class FixedStepSimulator : public CheckedSimulator {
   double dt_ = 0.0;
   long long n_steps_ = 0;
   WorkCounters work_;
+  // The bench-applied friction of the last step (viscous, gliding), for contact_forces().
+  BenchFrictionForces bench_applied_;
 };
 
 }  // namespace tippe

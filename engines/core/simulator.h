@@ -48,6 +48,25 @@ struct MassReadback {
   Eigen::Matrix3d I_G_B = Eigen::Matrix3d::Zero();
 };
 
+// One contact surface's force on the top over the last step, as the engine computed it (its
+// solver's or its force law's, never recomputed by the bench): the floor's normal is +z, so F_n is
+// the force's z part and the friction force F_t its horizontal part. With several engine points on
+// one surface, F_n and F_t are their sums and p_WC their F_n-weighted mean.
+struct SurfaceContactForce {
+  bool active = false;        // the engine reports a contact on this surface
+  double f_n = 0.0;           // normal force
+  Vec3 f_t_W = Vec3::Zero();  // tangential (friction) force, lab frame
+  bool point_valid = false;   // p_WC is known (F_n > 0)
+  Vec3 p_WC = Vec3::Zero();   // point of application, lab frame
+};
+
+// The forces at the top's two contact surfaces. Where the bench applies the friction law itself
+// (viscous, gliding), F_t is the force the bench applied in that step.
+struct EngineContactForces {
+  SurfaceContactForce ball, stem;
+  Vec3 friction_W() const { return ball.f_t_W + stem.f_t_W; }
+};
+
 // Ordered key=value pairs of every setting that decides accuracy, as used in the run.
 using SettingsList = std::vector<std::pair<std::string, std::string>>;
 
@@ -75,6 +94,13 @@ class Simulator {
   // events().size() without the copy (a run asks after every sample).
   virtual size_t event_count() const { return events().size(); }
   virtual SettingsList settings() const = 0;
+  // The contact forces of the last step (of the initial state before the first): an adapter
+  // supplies what its engine computed; the default is a simulator that reports none.
+  virtual EngineContactForces contact_forces() const { return {}; }
+  // The work of the friction forces of contact_forces() over the run so far: per step, F_t . v_C
+  // times the step at each surface, v_C the velocity of the top's material point at the force's
+  // point at the end of the step. NaN where the simulator reports no contact forces.
+  virtual double friction_work() const;
   // Notes on approximations in force (e.g. "rolling approximated by mu = 1e3").
   virtual std::vector<std::string> notes() const { return {}; }
 };

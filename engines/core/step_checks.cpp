@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -35,6 +36,28 @@ Observation observe_with_contacts(const BodyModel& body, const BodyState& x, con
   o.p_WC_engine = c.p_WC;
   return o;
 }
+
+void add_surface_force(ContactReport& r, bool stem, double f_n, const Vec3& f_t_W, const Vec3& p_W) {
+  (stem ? r.friction_stem_W : r.friction_ball_W) += f_t_W;
+  if (f_n > 0) {
+    (stem ? r.p_WC_stem : r.p_WC_ball) += f_n * p_W;
+    (stem ? r.weight_stem : r.weight_ball) += f_n;
+  }
+}
+
+void finish_surface_points(ContactReport& r) {
+  if (r.weight_ball > 0) r.p_WC_ball /= r.weight_ball;
+  if (r.weight_stem > 0) r.p_WC_stem /= r.weight_stem;
+}
+
+EngineContactForces contact_forces(const ContactReport& r) {
+  EngineContactForces f;
+  f.ball = {r.ball, r.normal_force_ball, r.friction_ball_W, r.weight_ball > 0, r.p_WC_ball};
+  f.stem = {r.stem, r.normal_force_stem, r.friction_stem_W, r.weight_stem > 0, r.p_WC_stem};
+  return f;
+}
+
+double Simulator::friction_work() const { return std::numeric_limits<double>::quiet_NaN(); }
 
 StepChecks::StepProbe StepChecks::probe(const BodyState& x) const {
   StepProbe p;
@@ -78,6 +101,7 @@ bool StepChecks::after_step(double t, const BodyState& y, const ContactReport& c
     return false;
   }
   const StepProbe now = probe(y);
+  add_friction_work(y, y.t - last_.state.t, c);
   track_events(last_, now, c);
   last_ = now;
   const double gap = std::min(now.gap_ball, now.gap_stem);
@@ -102,6 +126,22 @@ bool StepChecks::after_step(double t, const BodyState& y, const ContactReport& c
     return false;
   }
   return true;
+}
+
+void StepChecks::add_friction_work(const BodyState& y, double h, const ContactReport& c) {
+  // The force acts over the step and the engines' solves make it consistent with the velocity
+  // the step ends with (a sticking contact ends at v_C = 0 and does no work): the end state's
+  // material-point velocity at the force's point (the geometric contact point when the engine
+  // gave none).
+  const Vec3 w_W = y.q_WB * y.w_B;
+  for (const Surface s : {Surface::Ball, Surface::Stem}) {
+    const bool stem = s == Surface::Stem;
+    const Vec3& f = stem ? c.friction_stem_W : c.friction_ball_W;
+    if (f.isZero(0.0) || (stem && !body_.stem)) continue;
+    const double weight = stem ? c.weight_stem : c.weight_ball;
+    const Vec3 r = weight > 0 ? Vec3((stem ? c.p_WC_stem : c.p_WC_ball) - y.p_WG) : contact_offset_W(body_, y.q_WB, s);
+    friction_work_ += f.dot(y.v_WG + w_W.cross(r)) * h;
+  }
 }
 
 void StepChecks::track_events(const StepProbe& a, const StepProbe& b, const ContactReport& c) {

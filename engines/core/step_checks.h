@@ -19,7 +19,20 @@ struct ContactReport {
   double normal_force_stem = 0.0;  // ... on the stem geom
   bool point_valid = false;
   Vec3 p_WC = Vec3::Zero();        // engine's contact point (force-weighted mean when several)
+  // Per surface, the friction force on the top (lab frame) and the F_n-weighted point: filled by
+  // add_surface_force and finish_surface_points, read by contact_forces().
+  Vec3 friction_ball_W = Vec3::Zero(), friction_stem_W = Vec3::Zero();
+  Vec3 p_WC_ball = Vec3::Zero(), p_WC_stem = Vec3::Zero();
+  double weight_ball = 0.0, weight_stem = 0.0;  // the positive F_n summed into each point
 };
+
+// Adds one engine contact point's friction force and its point to the per-surface fields of r (the
+// normal sums, flags and mean point are the adapter's own, unchanged); finish_surface_points
+// turns the weighted sums into points once every point is in.
+void add_surface_force(ContactReport& r, bool stem, double f_n, const Vec3& f_t_W, const Vec3& p_W);
+void finish_surface_points(ContactReport& r);
+// The report as the simulator interface carries it.
+EngineContactForces contact_forces(const ContactReport& r);
 
 // Limits that turn a run into a result instead of a crash (issue: failures are results).
 struct FailureLimits {
@@ -63,6 +76,8 @@ class StepChecks {
   const std::vector<Event>& events() const { return events_; }
   // The state the last accepted step ended in (or the start's, or set_state's).
   const BodyState& last_state() const { return last_.state; }
+  // The friction work of the steps so far (Simulator::friction_work).
+  double friction_work() const { return friction_work_; }
 
  private:
   struct StepProbe {
@@ -70,6 +85,7 @@ class StepChecks {
     double cos_theta = 1.0, gap_ball = 0.0, gap_stem = 0.0;
   };
   StepProbe probe(const BodyState& x) const;
+  void add_friction_work(const BodyState& y, double h, const ContactReport& c);
   void track_events(const StepProbe& before, const StepProbe& after, const ContactReport& c);
 
   BodyModel body_;
@@ -81,6 +97,7 @@ class StepChecks {
   std::vector<Event> events_;
   StepProbe last_;
   bool inverted_ = false, stem_touched_ = false;
+  double friction_work_ = 0.0;
   Surface contact_surface_ = Surface::Ball;
 };
 
@@ -100,6 +117,7 @@ class CheckedSimulator : public Simulator {
   std::string status_detail() const override { return checks_.status_detail(); }
   std::vector<Event> events() const override { return checks_.events(); }
   size_t event_count() const override { return checks_.events().size(); }
+  double friction_work() const override { return checks_.friction_work(); }
 
  protected:
   explicit CheckedSimulator(const Scene& scene) : checks_(BodyModel::from_scene(scene)) {}

@@ -251,7 +251,12 @@ void DartSimulator::read_contacts() {
     r.normal_force += f_n;
     (on_stem ? r.normal_force_stem : r.normal_force_ball) += f_n;
     moment += f_n * c.point;
+    // ContactConstraint::applyImpulse stores in Contact::force the normal and both tangent
+    // impulses of the step over dt, in the lab frame: its horizontal part is the friction force.
+    const Eigen::Vector3d f_W = (a == ball_ || a == stem_) ? Eigen::Vector3d(c.force) : Eigen::Vector3d(-c.force);
+    add_surface_force(r, on_stem, f_n, Vec3(f_W.x(), f_W.y(), 0.0), c.point);
   }
+  finish_surface_points(r);
   if (r.normal_force > 0) {
     r.point_valid = true;
     r.p_WC = moment / r.normal_force;

@@ -410,6 +410,13 @@ ContactReport MujocoSimulator::read_contacts(const mjData* data) const {
     mj_contactForce(m_, data, i, f);
     r.normal_force += f[0];
     (g == ball_id_ ? r.normal_force_ball : r.normal_force_stem) += f[0];
+    // The force on geom2 in the lab frame: the contact frame's rows (normal, two tangents) are
+    // lab-frame axes, its normal pointing from geom1 to geom2; on the top when it is geom1, the
+    // opposite. Its horizontal part is the friction force (the floor's normal is +z).
+    Vec3 f_W = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) f_W += f[k] * Vec3(c.frame[3 * k], c.frame[3 * k + 1], c.frame[3 * k + 2]);
+    if (c.geom1 == g) f_W = -f_W;
+    add_surface_force(r, g == stem_id_, f[0], Vec3(f_W.x(), f_W.y(), 0.0), Vec3(c.pos[0], c.pos[1], c.pos[2]));
     if (f[0] > 0) {
       // c.pos lies midway between the two surfaces: within the penetration depth of the floor.
       moment += f[0] * Vec3(c.pos[0], c.pos[1], c.pos[2]);
@@ -420,6 +427,7 @@ ContactReport MujocoSimulator::read_contacts(const mjData* data) const {
     r.point_valid = true;
     r.p_WC = moment / weight;
   }
+  finish_surface_points(r);
   return r;
 }
 

@@ -362,7 +362,10 @@ void OdeSimulator::engine_step() {
     r.normal_force += f_n;
     (c.stem ? r.normal_force_stem : r.normal_force_ball) += f_n;
     moment += f_n * c.p_W;
+    // f1 is in the lab frame: its horizontal part is the friction force of the tangent rows.
+    add_surface_force(r, c.stem, f_n, Vec3(c.feedback.f1[0], c.feedback.f1[1], 0.0), c.p_W);
   }
+  finish_surface_points(r);
   if (r.normal_force > 0) {
     r.point_valid = true;
     r.p_WC = moment / r.normal_force;

@@ -42,6 +42,9 @@ class SphereOnFloorR : public NewtonEuler3DR {
     _Nc->setValue(2, 1.0);
   }
 
+ // The lab-to-contact-frame rotation of the last Jacobian (rows: normal, two tangents).
+  const SimpleMatrix& abs_to_contact() const { return *_rotationAbsoluteToContactFrame; }
+
  private:
   double cx_, cy_, cz_, radius_;
 };

@@ -75,6 +75,7 @@ class SiconosSimulator : public CheckedSimulator {
   MassReadback mass_properties() const override;
   WorkCounters work() const override { return work_; }
   SettingsList settings() const override { return list_settings(settings_); }
+  EngineContactForces contact_forces() const override { return tippe::contact_forces(report_); }
   std::vector<std::string> notes() const override;
 
  private:
@@ -103,6 +104,7 @@ class SiconosSimulator : public CheckedSimulator {
   long long solver_unconverged_ = 0, newton_unconverged_ = 0;
   double worst_residual_ = 0.0;
   ContactReport report_;
+  BenchFrictionForces bench_applied_;  // the bench's viscous or gliding force of the last step
 };
 
 SiconosSimulator::SiconosSimulator(const Scene& scene)
@@ -263,7 +265,16 @@ ContactReport SiconosSimulator::read_contacts() const {
     const auto rel = std::static_pointer_cast<NewtonEuler1DR>(inter->relation());
     const SiconosVector& pc = *rel->pc1();
     moment += f_n * Vec3(pc.getValue(0), pc.getValue(1), pc.getValue(2));
+    // The impulse in the contact frame (normal, two tangents) over h, turned into the lab frame by
+    // the transpose of the relation's lab-to-contact rotation; its horizontal part is friction.
+    const SiconosVector& p = *inter->lambda(1);
+    const SimpleMatrix& R = std::static_pointer_cast<SphereOnFloorR>(inter->relation())->abs_to_contact();
+    Vec3 f_W = Vec3::Zero();
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) f_W(i) += R.getValue(k, i) * p.getValue(k) / settings_.timestep;
+    add_surface_force(r, on_stem, f_n, Vec3(f_W.x(), f_W.y(), 0.0), Vec3(pc.getValue(0), pc.getValue(1), pc.getValue(2)));
   }
+  finish_surface_points(r);
   if (r.normal_force > 0) {
     r.point_valid = true;
     r.p_WC = moment / r.normal_force;
@@ -276,6 +287,7 @@ ContactReport SiconosSimulator::read_contacts() const {
 void SiconosSimulator::bench_forces() {
   if (!bench_applies_friction(scene_.contact.friction)) return;
   const BenchFrictionForces bf = bench_friction_forces(body_, scene_.contact, checks_.last_state(), report_);
+  bench_applied_ = bf;
   Vec3 f = Vec3::Zero(), mo = Vec3::Zero();
   for (int i = 0; i < bf.n; ++i) {
     f += bf.f_W[i];
@@ -323,6 +335,7 @@ void SiconosSimulator::step_once() {
   if (sim_->getNewtonNbIterations() >= static_cast<unsigned>(settings_.newton_max_iterations)) ++newton_unconverged_;
   const double t = time();
   report_ = read_contacts();
+  add_bench_friction(report_, bench_applied_);
   checks_.after_step(t, read_state(), report_);
 }
 

@@ -83,6 +83,7 @@ class SimbodySimulator : public CheckedSimulator {
   MassReadback mass_properties() const override;
   WorkCounters work() const override;
   SettingsList settings() const override { return list_settings(settings_); }
+  EngineContactForces contact_forces() const override { return tippe::contact_forces(report_); }
   std::vector<std::string> notes() const override { return notes_; }
 
  private:
@@ -110,6 +111,7 @@ class SimbodySimulator : public CheckedSimulator {
   WorkCounters work_;
   long long realizations_before_ = 0, iterations_before_ = 0;  // of integrators replaced by set_state
   ContactReport report_;
+  std::vector<SphereSpec> spheres_;  // ball, then stem: for the bench's viscous force in reports
 };
 
 SimbodySimulator::SimbodySimulator(const Scene& scene)
@@ -159,6 +161,7 @@ SimbodySimulator::SimbodySimulator(const Scene& scene)
   }
   top_ = MobilizedBody::Free(matter_.Ground(), Transform(), body, Transform());
   if (friction_.bench_viscous) Force::Custom(forces_, new ViscousContactForce(top_, spheres, scene.contact.k));
+  spheres_ = spheres;
 
   system_.realizeTopology();
   ball_surface_ = tracker_.getContactSurfaceIndex(top_, ball);
@@ -281,6 +284,24 @@ ContactReport SimbodySimulator::read_contacts(const SimTK::State& s) const {
     r.normal_force += f_n;
     (on_stem ? r.normal_force_stem : r.normal_force_ball) += f_n;
     moment += f_n * to_eigen(f.getContactPoint());
+    // The compliant force law's force at the state (Ground frame = lab): its horizontal part is
+    // the friction force.
+    const SimTK::Vec3 f_W = (top_second ? 1.0 : -1.0) * f.getForceOnSurface2()[1];
+    add_surface_force(r, on_stem, f_n, Vec3(f_W[0], f_W[1], 0.0), to_eigen(f.getContactPoint()));
+  }
+  finish_surface_points(r);
+  if (friction_.bench_viscous) {
+    // The bench's viscous force as ViscousContactForce evaluates it at this state.
+    const SimTK::Transform& X = top_.getBodyTransform(s);
+    const SimTK::SpatialVec& V = top_.getBodyVelocity(s);
+    for (size_t i = 0; i < spheres_.size(); ++i) {
+      const SimTK::Vec3 centre = X * spheres_[i].centre_B;
+      if (centre[2] - spheres_[i].radius >= 0) continue;
+      const SimTK::Vec3 p = centre - SimTK::Vec3(0, 0, spheres_[i].radius);
+      SimTK::Vec3 v_C = V[1] + V[0] % (p - X.p());
+      v_C[2] = 0;
+      (i == 1 ? r.friction_stem_W : r.friction_ball_W) += to_eigen(-scene_.contact.k * v_C);
+    }
   }
   if (r.normal_force > 0) {
     r.point_valid = true;

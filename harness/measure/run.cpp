@@ -74,6 +74,7 @@ RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, Pr
   r.settings = sim.settings();
   r.notes = sim.notes();
   r.work = sim.work();
+  r.friction_work = sim.friction_work();
   r.work.wall_seconds = wall;
   r.work.cpu_seconds = cpu;
   for (const Event& e : r.events) {

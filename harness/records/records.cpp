@@ -130,6 +130,7 @@ json to_json(const RunRecord& r) {
       {"jellett_drift_ball", number(r.jellett_drift_ball)},
       {"jellett_drift_stem", number(r.jellett_drift_stem)},
       {"min_normal_force", number(r.min_normal_force)},
+      {"friction_work", number(r.friction_work)},
       {"mass_properties",
        {{"mass", number(r.mass.mass)},
         {"com_offset", number(r.mass.com_offset)},
@@ -233,6 +234,8 @@ RunRecord from_json(const json& j) {
   r.jellett_drift_ball = get_optional(j, "jellett_drift_ball");
   r.jellett_drift_stem = get_optional(j, "jellett_drift_stem");
   r.min_normal_force = get_number(j, "min_normal_force");
+  // Absent from records written before it: read as not reported.
+  r.friction_work = j.contains("friction_work") ? get_number(j, "friction_work") : kNaN;
   const json& m = j.at("mass_properties");
   r.mass = {get_number(m, "mass"), get_number(m, "com_offset"), get_number(m, "inertia_transverse"),
             get_number(m, "inertia_axial")};

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <istream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -68,6 +69,9 @@ struct RunRecord {
   double jellett_max_relative_drift = 0.0;
   std::optional<double> jellett_drift_ball, jellett_drift_stem;  // absent: no run on that surface
   double min_normal_force = 0.0;
+  // The work of the friction forces the simulator reported (Simulator::friction_work), scene
+  // units of energy; NaN (JSON null) where it reports none, and in records written before it.
+  double friction_work = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Receives every sample of a run as it is produced, so a run's memory does not grow with its length.

@@ -456,6 +456,18 @@ TEST(Records, FormatIsWrittenAndOldSummariesAreRead) {
   EXPECT_THROW(from_json(j), nlohmann::json::exception);
 }
 
+// friction_work (Simulator::friction_work) round-trips; a summary written before it existed is
+// read as not reported (NaN), and not reported is written as null.
+TEST(Records, FrictionWorkRoundTripsAndOldSummariesReadWithoutIt) {
+  RunRecord r = example_record();
+  r.friction_work = -0.0111;
+  nlohmann::json j = to_json(r);
+  EXPECT_EQ(from_json(j).friction_work, -0.0111);
+  j.erase("friction_work");
+  EXPECT_TRUE(std::isnan(from_json(j).friction_work));
+  EXPECT_TRUE(to_json(from_json(j)).at("friction_work").is_null());
+}
+
 bool has_temporaries(const fs::path& dir) {
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().filename().string().find(".tmp.") != std::string::npos) return true;
