@@ -24,6 +24,7 @@
 
 #include "advise/advise.h"
 #include "io/output_dir.h"
+#include "io/progress.h"
 #include "io/scene_io.h"
 #include "library/verbs.h"
 #include "measure/run.h"
@@ -262,6 +263,18 @@ SceneSource source_of(const py::dict& d) {
 
 std::string dump(const nlohmann::json& j) { return j.dump(2) + "\n"; }
 
+// progress=False: the harness's own progress (boards, sweep lines) silent for the call, as --quiet.
+class QuietUnless {
+ public:
+  explicit QuietUnless(bool progress) : saved_(tippe::progress_mode()) {
+    if (!progress) tippe::set_progress_mode(tippe::ProgressMode::Quiet);
+  }
+  ~QuietUnless() { tippe::set_progress_mode(saved_); }
+
+ private:
+  tippe::ProgressMode saved_;
+};
+
 }  // namespace
 
 PYBIND11_MODULE(_tippe, m) {
@@ -331,6 +344,7 @@ PYBIND11_MODULE(_tippe, m) {
         SceneSource src = source_of(source);
         src.self_check = self_check;
         Runner runner(callback);
+        const QuietUnless quiet(board);
         std::map<std::string, tippe::Trajectory> trajectories;
         tippe::Comparison c;
         runner.run([&] {
@@ -386,6 +400,7 @@ PYBIND11_MODULE(_tippe, m) {
       "sweep",
       [](const std::string& path, const std::string& out, int jobs, bool restart, bool plots, bool progress) {
         tippe::SweepOutcome r;
+        const QuietUnless quiet(progress);
         Runner runner{py::none()};
         runner.run([&] {
           const tippe::SweepPlan plan = tippe::load_sweep(path);
@@ -431,6 +446,7 @@ PYBIND11_MODULE(_tippe, m) {
         o.plots = plots;
         o.progress = progress;
         tippe::AdviceResult r;
+        const QuietUnless quiet(progress);
         Runner runner{py::none()};
         runner.run([&] {
           try {
@@ -448,8 +464,9 @@ PYBIND11_MODULE(_tippe, m) {
   m.def(
       "gate",
       [](const std::string& gates, int jobs, const std::string& cache, const std::string& boundary_out,
-         bool self_check) {
+         bool self_check, bool progress) {
         std::vector<tippe::CheckResult> results;
+        const QuietUnless quiet(progress);
         Runner runner{py::none()};
         runner.run([&] {
           const tippe::GatePlan plan = tippe::load_gate_plan(gates);

@@ -228,10 +228,10 @@ def advise(scene: SceneLike, out: str | None = None, *, engines: Iterable[str] =
 
 
 def gate(file: Union[str, os.PathLike], *, jobs: int = 0, cache: str | None = DEFAULT_CACHE,
-         boundary_out: str = "out/.boundary-runs", self_check: bool = True) -> GateResult:
+         boundary_out: str = "out/.boundary-runs", self_check: bool = True, progress: bool = True) -> GateResult:
     """Runs a gate file's checks (`tippe gate`): its --json record, ``passed`` and the table."""
     text, table, passed = _tippe.gate(os.fspath(file), int(jobs), os.fspath(cache) if cache else "",
-                                      os.fspath(boundary_out), bool(self_check))
+                                      os.fspath(boundary_out), bool(self_check), bool(progress))
     g = GateResult.from_json(text)
     object.__setattr__(g, "passed", passed)
     object.__setattr__(g, "table", table)

@@ -51,7 +51,11 @@ class Record:
         return sorted(set(super().__dir__()) | set(self._data))
 
     def __eq__(self, other: object) -> bool:
+        if isinstance(other, dict):
+            return self._data == other
         return isinstance(other, Record) and self._data == other._data
+
+    __hash__ = None  # mutable underneath, as a dict
 
     def keys(self) -> list[str]:
         return list(self._data)
