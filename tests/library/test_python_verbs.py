@@ -305,6 +305,10 @@ def test_engines(exe, src, tmp):
     e = tippe.engines()
     check(f"engines() names {[x.name for x in e]} == tippe --version's {listed}", [x.name for x in e] == listed)
     check("__version__", version[0].startswith(f"tippe {tippe.__version__} "))
+    import tomllib
+
+    project = tomllib.loads((src / "pyproject.toml").read_text())["project"]
+    check(f"pyproject.toml's version {project['version']} == __version__", project["version"] == tippe.__version__)
     ode = next(x for x in e if x.name == "ode")
     ts = next(s for s in ode.settings if s.key == "timestep")
     check(f"a setting's default and bounds: {ts.to_dict()}", ts.type == "number" and ts.default > 0 and
