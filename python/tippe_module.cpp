@@ -4,6 +4,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <csignal>
 #include <chrono>
 #include <condition_variable>
@@ -170,9 +171,16 @@ class Runner {
         finished = done_;
         events.swap(events_);
       }
+      // A run's samples since the last look come as its latest (one call per run and 0.1 s).
+      std::deque<ProgressEvent> latest;
+      for (const ProgressEvent& e : events) {
+        auto same = std::find_if(latest.begin(), latest.end(), [&](const ProgressEvent& l) { return l.run == e.run; });
+        if (same == latest.end()) latest.push_back(e);
+        else *same = e;
+      }
       if (!python_error) {
         try {
-          for (const ProgressEvent& e : events) callback_(e.run, e.t, e.duration);
+          for (const ProgressEvent& e : latest) callback_(e.run, e.t, e.duration);
           if (PyErr_CheckSignals() != 0) throw py::error_already_set();
         } catch (py::error_already_set& e) {
           python_error = std::move(e);
