@@ -19,6 +19,8 @@ namespace tippe {
 namespace {
 
 namespace fs = std::filesystem;
+using fixtures::bit_equal;
+using fixtures::kScenesDir;
 
 // The columns the Python module hands over as arrays are the numbers trajectory.csv's text reads
 // back to, bit for bit (17 significant digits round-trip a double), in the file's column order:
