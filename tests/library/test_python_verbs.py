@@ -131,8 +131,26 @@ def test_compare(exe, src, tmp):
     scene = str(src / "harness/scenes/toy_viscous.toml")
     args = ["--engines", "ode,mujoco", "--set", "run.duration=1", "--no-cache", "--no-plots"]
     cli(exe, "compare", scene, *args, "--out", str(tmp / "cli"))
+    # Another Python thread runs meanwhile: the comparison holds no GIL.
+    import threading
+
+    ticks, done = [0], threading.Event()
+
+    def tick():
+        while not done.is_set():
+            ticks[0] += 1
+            time.sleep(0.001)
+
+    ticker = threading.Thread(target=tick)
+    ticker.start()
+    t0 = time.monotonic()
     c = tippe.compare(scene, ["ode", "mujoco"], set=["run.duration=1"], cache=None, out=str(tmp / "py"),
                       progress=False)
+    elapsed = time.monotonic() - t0
+    done.set()
+    ticker.join()
+    # At most one tick per ms, at least one per 10 ms of a loaded machine.
+    check(f"a thread ran during compare: {ticks[0]} ticks in {elapsed:.2f} s", ticks[0] >= elapsed * 100 * 0.5)
     cli_json = (tmp / "cli/comparison.json").read_text()
     same_text("compare(): comparison.json", c.json, cli_json)
     check("compare(out=): the file is the record", (tmp / "py/comparison.json").read_text() == c.json)
@@ -279,6 +297,11 @@ def test_sweep(exe, src, tmp):
           [x.to_dict() for x in r.records] == [json.loads(l) for l in mine])
     df = r.to_pandas()
     check(f"to_pandas: a row per point ({len(df)})", len(df) == r.points and "metrics.tilt_rms_error" in df)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    ax = r.plot("tilt_rms_error")
+    check("plot(): the work-precision figure, a line per setup", len(ax.get_lines()) == 1)
     again = tippe.sweep(sweep, out=str(tmp / "py"), progress=False)
     check("a rerun resumes", again.ran == 0 and again.skipped == r.points)
     # A dict with a sweep file's keys, scenes relative to the current directory.
