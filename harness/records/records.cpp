@@ -265,6 +265,8 @@ const std::vector<std::string>& trajectory_columns() {
       "qw",       "qx",         "qy",         "qz",         "wx_B",         "wy_B",       "wz_B",
       "theta",    "surface",    "x_C",        "y_C",        "z_C",          "x_C_engine", "y_C_engine",
       "z_C_engine", "normal_force", "slip_speed", "energy", "jellett", "contact_latitude"};
+  // trajectory_row_values fills kTrajectoryColumns values, one per name here.
+  if (cols.size() != kTrajectoryColumns) throw std::logic_error("trajectory_columns and kTrajectoryColumns disagree");
   return cols;
 }
 
