@@ -5,6 +5,8 @@ pkgs=(cmake g++ make pkg-config libeigen3-dev libbullet-dev libode-dev libmujoco
       libgtest-dev libgmock-dev libboost-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
       libbenchmark-dev gnuplot-nox
       python3-dev python3-pybind11 python3-numpy  # the Python module tippe (docs/library.md)
+      python3-pandas python3-matplotlib  # tippe's to_pandas() and plot(), and their tests (docs/python.md)
+      python3-setuptools python3-wheel python3-venv python3-pip  # pip install --no-build-isolation . (docs/python.md)
       python3-jsonschema  # the records against schemas/ (Library.RecordsMatchSchemas)
       libdart-dev libdart-external-ikfast-dev  # DART 6.12 (engines/dart/dart_sim.cpp); dart/dart.hpp needs ikfast's headers
       libsimbody-dev  # Simbody 3.7 (engines/simbody/): the error-controlled, compliant-contact engine

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <tippe/tippe.h>
 
 #include "io/interrupt.h"
 #include "io/output_dir.h"
@@ -33,7 +34,7 @@ struct Command {
 using Setup = Command (*)(CLI::App& app);
 
 // A subcommand's exception as an exit code, its message on stderr when `print`: bad input
-// (SceneError, UsageError) and an unusable output path (OutputError) -> 2; a signal that ended
+// (SceneError, UsageError, InputError) and an unusable output path (OutputError) -> 2; a signal that ended
 // the command cleanly (Interrupted) -> 128 + its number, as a shell reports a signal; anything
 // else is a bug -> kInternalExit, said as "internal". 1 is a failing gate's alone, so that CI can
 // tell "the settings fail" from "tippe broke".
@@ -50,6 +51,9 @@ inline int error_exit(const std::exception_ptr& e, bool print = true) {
     if (print) std::cerr << "tippe: error: " << x.what() << "\n";
     return 2;
   } catch (const UsageError& x) {
+    if (print) std::cerr << "tippe: error: " << x.what() << "\n";
+    return 2;
+  } catch (const InputError& x) {  // the library's (library/verbs.h), as UsageError
     if (print) std::cerr << "tippe: error: " << x.what() << "\n";
     return 2;
   } catch (const OutputError& x) {

@@ -8,6 +8,7 @@
 
 #include "registry.h"
 #include "cli/cli.h"
+#include "library/verbs.h"
 #include "measure/compare.h"
 #include "report/report.h"
 #include "io/files.h"
@@ -32,41 +33,20 @@ struct CompareCliOptions {
   bool no_self_check = false;
 };
 
-void print_table_and_findings(const nlohmann::json& j) {
-  // The scene's own notes (an imported model's approximations) head the report.
-  if (j.contains("scene") && j.at("scene").is_object())
-    for (const auto& n : j.at("scene").value("notes", nlohmann::json::array()))
-      if (n.is_string()) std::printf("scene note: %s\n", n.get<std::string>().c_str());
-  std::printf("%s", render_summary_table(j).c_str());
-  for (const auto& f : report_findings(j)) std::printf("- %s\n", f.c_str());
-}
+void print_table_and_findings(const nlohmann::json& j) { std::printf("%s", comparison_summary_text(j).c_str()); }
 
 int compare(const CompareCliOptions& o) {
   Scene scene = load_scene(o.scene, o.sets);
   if (o.no_self_check) scene.run.self_check = false;
-  CompareOptions opts;
-  opts.engines = o.engines;
-  const int runs = static_cast<int>(o.engines.size()) + 1;
-  opts.jobs = o.jobs > 0 ? o.jobs : std::max(1, std::min(runs, static_cast<int>(std::thread::hardware_concurrency())));
-  const fs::path dir = o.out.empty() ? fs::path("out") / (scene.name + "-compare") : fs::path(o.out);
-  opts.cache_dir = o.no_cache ? "" : o.cache;
-  // run_comparison checks its input before it writes anything; so does this, before DIR exists.
-  try {
-    check_compare_input(scene, opts);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  // The comparison's files are one unit, written beside DIR and swapped in whole.
-  const InterruptGuard interrupts;
-  std::vector<fs::path> inputs = scene_input_files(scene);
-  if (!opts.cache_dir.empty()) inputs.emplace_back(opts.cache_dir);  // the cache outlives the output
-  OutputDir out(dir, OutputKind::Comparison, inputs);
-  opts.out_dir = out.stage(false).string();
-  const Comparison c = run_comparison(scene, opts);
-  write_report(opts.out_dir, to_json(c), !o.no_plots);
-  out.commit();
+  CompareRequest request;
+  request.engines = o.engines;
+  request.jobs = o.jobs;
+  request.out = o.out.empty() ? (fs::path("out") / (scene.name + "-compare")).string() : o.out;
+  request.cache = o.no_cache ? "" : o.cache;
+  request.plots = !o.no_plots;
+  const Comparison c = compare_scene(scene, request);
   print_table_and_findings(to_json(c));
-  std::printf("report: %s\n", (dir / "index.html").string().c_str());
+  std::printf("report: %s\n", (fs::path(request.out) / "index.html").string().c_str());
   return 0;
 }
 

@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "library/columns.h"
 #include "records/records.h"
 #include "measure/run.h"
 #include "io/scene_io.h"
@@ -47,26 +48,28 @@ RunSummary to_summary(const RunRecord& r) {
   return s;
 }
 
-// The trajectory goes through the CSV text that `tippe run` writes (17 significant digits, so
-// every number reads back to the same double): the columns are the file's by construction.
-void fill_trajectory(const CsvTrajectoryText& csv, TrajectoryColumns& out) {
-  std::istringstream in(csv.text);
-  const CsvTrajectory t = parse_trajectory_csv(in, "trajectory");
-  out.columns = t.columns;
-  out.values = t.values;
-  out.surface.clear();
-  out.surface.reserve(t.rows());
-  for (int code : t.surface) out.surface.emplace_back(to_string(static_cast<Surface>(code)));
-}
-
 RunSummary run_reference(const Scene& scene, TrajectoryColumns* trajectory) {
-  CsvTrajectoryText csv;
-  const RunRecord r = run_scene(scene, "analytic", trajectory ? &csv : nullptr);
-  if (trajectory) fill_trajectory(csv, *trajectory);
+  ColumnTrajectorySink columns;
+  const RunRecord r = run_scene(scene, "analytic", trajectory ? &columns : nullptr);
+  if (trajectory) *trajectory = std::move(columns.columns);
   return to_summary(r);
 }
 
 }  // namespace
+
+ColumnTrajectorySink::ColumnTrajectorySink() {
+  columns.columns = trajectory_columns();
+  for (const std::string& c : columns.columns) slots_.push_back(c == "surface" ? nullptr : &columns.values[c]);
+}
+
+void ColumnTrajectorySink::write(const Observation& o) {
+  double v[kTrajectoryColumns];
+  trajectory_row_values(o, v);
+  for (size_t i = 0; i < kTrajectoryColumns; ++i) {
+    if (slots_[i]) slots_[i]->push_back(v[i]);
+    else columns.surface.emplace_back(to_string(o.surface));
+  }
+}
 
 RunSummary run_scene_file(const std::string& path, const std::vector<std::string>& overrides,
                           TrajectoryColumns* trajectory) {

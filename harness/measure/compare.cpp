@@ -148,6 +148,7 @@ struct Task {
   std::string cache_csv_path;  // reference only: a copy for the cache
   RunRecord record;
   Trajectory trajectory;
+  std::function<void(double t, double duration)> progress;  // CompareOptions::on_progress for this run
   std::exception_ptr fatal;  // output failure: the comparison cannot be completed
 };
 
@@ -179,7 +180,10 @@ void run_task(Task& task, const Scene& scene, ProgressBoard& board, size_t slot)
   GuardedSink out(csv.get(), true), cache(cache_csv.get(), false);
   TrajectorySink sink({&out, &cache});
   try {
-    task.record = run_simulator(*sim, scene, &sink, [&](double t, double) { board.set_time(slot, t); });
+    task.record = run_simulator(*sim, scene, &sink, [&](double t, double duration) {
+      board.set_time(slot, t);
+      if (task.progress) task.progress(t, duration);
+    });
   } catch (const Interrupted&) {
     // A signal ends the comparison, not this run: nothing of it is recorded.
     task.fatal = std::current_exception();
@@ -300,6 +304,11 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
 
   std::vector<std::string> names;
   for (size_t i = 0; i < tasks.size(); ++i) names.push_back(i && i == check_slot ? "self-check" : tasks[i].engine);
+  if (options.on_progress)
+    for (size_t i = 0; i < tasks.size(); ++i)
+      tasks[i].progress = [&options, name = i == 0 ? std::string("reference") : names[i]](double t, double d) {
+        options.on_progress(name, t, d);
+      };
   ProgressBoard board(scene.name, names, scene.run.duration);
   std::vector<size_t> todo;
   for (size_t i = 0; i < tasks.size(); ++i) {
@@ -352,6 +361,11 @@ Comparison run_comparison(const Scene& scene, const CompareOptions& options) {
     if (i == check_slot) continue;
     Metrics m = compare_runs(ref.record, ref.trajectory, tasks[i].record, tasks[i].trajectory, scene, converged_until);
     c.engines.push_back({std::move(tasks[i].record), m});
+  }
+  if (options.trajectories) {
+    (*options.trajectories)["reference"] = ref.trajectory;
+    for (size_t i = 1; i < tasks.size(); ++i)
+      if (i != check_slot) (*options.trajectories)[tasks[i].engine] = std::move(tasks[i].trajectory);
   }
 
   if (!out.empty()) {

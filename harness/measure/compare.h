@@ -1,6 +1,8 @@
 // Side-by-side runs of the reference and engines on one scene into a comparison record.
 #pragma once
 
+#include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,11 @@ struct CompareOptions {
   std::string out_dir;    // where comparison.json, trajectories and reports go ("" = none)
   std::string cache_dir;  // reference cache ("" = no cache)
   bool progress = true;   // progress line on stderr
+  // Each run's time as it goes, called from the worker threads ("reference", "self-check" or
+  // the engine's name), for a caller's own display (the Python module's callback).
+  std::function<void(const std::string& run, double t, double duration)> on_progress;
+  // When set: each run's sampled columns, by the same names (the self-check's not kept).
+  std::map<std::string, Trajectory>* trajectories = nullptr;
 };
 
 // in parallel when jobs > 1, and (scene.run.self_check) the reference's self-check beside them;

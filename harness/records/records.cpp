@@ -265,6 +265,8 @@ const std::vector<std::string>& trajectory_columns() {
       "qw",       "qx",         "qy",         "qz",         "wx_B",         "wy_B",       "wz_B",
       "theta",    "surface",    "x_C",        "y_C",        "z_C",          "x_C_engine", "y_C_engine",
       "z_C_engine", "normal_force", "slip_speed", "energy", "jellett", "contact_latitude"};
+  // trajectory_row_values fills kTrajectoryColumns values, one per name here.
+  if (cols.size() != kTrajectoryColumns) throw std::logic_error("trajectory_columns and kTrajectoryColumns disagree");
   return cols;
 }
 
@@ -291,36 +293,44 @@ void CsvTrajectoryWriter::fail(const std::string& what) {
   throw OutputError(path_ + ": " + what + ": " + why);
 }
 
-size_t format_trajectory_row(const Observation& o, char* line) {
-  char* p = line;
-  char* const end = line + kTrajectoryRowMax;
-  auto put = [&](double v) {
-    if (p != line) *p++ = ',';
-    p = std::to_chars(p, end, v, std::chars_format::general, 17).ptr;
-  };
-  auto put_text = [&](const char* s) {
-    *p++ = ',';
-    while (*s) *p++ = *s++;
-  };
+void trajectory_row_values(const Observation& o, double* values) {
+  double* v = values;
   const BodyState& x = o.state;
   const double nan = kNaN;
-  put(x.t);
-  for (int i = 0; i < 3; ++i) put(x.p_WG[i]);
-  for (int i = 0; i < 3; ++i) put(x.v_WG[i]);
-  put(x.q_WB.w());
-  put(x.q_WB.x());
-  put(x.q_WB.y());
-  put(x.q_WB.z());
-  for (int i = 0; i < 3; ++i) put(x.w_B[i]);
-  put(o.theta);
-  put_text(to_string(o.surface));
-  for (int i = 0; i < 3; ++i) put(o.p_WC[i]);
-  for (int i = 0; i < 3; ++i) put(o.engine_contact_valid ? o.p_WC_engine[i] : nan);
-  put(o.normal_force);
-  put(o.slip_speed);
-  put(o.energy);
-  put(o.jellett);
-  put(o.contact_latitude);
+  *v++ = x.t;
+  for (int i = 0; i < 3; ++i) *v++ = x.p_WG[i];
+  for (int i = 0; i < 3; ++i) *v++ = x.v_WG[i];
+  *v++ = x.q_WB.w();
+  *v++ = x.q_WB.x();
+  *v++ = x.q_WB.y();
+  *v++ = x.q_WB.z();
+  for (int i = 0; i < 3; ++i) *v++ = x.w_B[i];
+  *v++ = o.theta;
+  *v++ = static_cast<double>(static_cast<int>(o.surface));
+  for (int i = 0; i < 3; ++i) *v++ = o.p_WC[i];
+  for (int i = 0; i < 3; ++i) *v++ = o.engine_contact_valid ? o.p_WC_engine[i] : nan;
+  *v++ = o.normal_force;
+  *v++ = o.slip_speed;
+  *v++ = o.energy;
+  *v++ = o.jellett;
+  *v++ = o.contact_latitude;
+}
+
+size_t format_trajectory_row(const Observation& o, char* line) {
+  static const size_t surface_column = static_cast<size_t>(
+      std::find(trajectory_columns().begin(), trajectory_columns().end(), "surface") - trajectory_columns().begin());
+  double values[kTrajectoryColumns];
+  trajectory_row_values(o, values);
+  char* p = line;
+  char* const end = line + kTrajectoryRowMax;
+  for (size_t i = 0; i < kTrajectoryColumns; ++i) {
+    if (i) *p++ = ',';
+    if (i == surface_column) {
+      for (const char* s = to_string(o.surface); *s;) *p++ = *s++;
+    } else {
+      p = std::to_chars(p, end, values[i], std::chars_format::general, 17).ptr;
+    }
+  }
   *p++ = '\n';
   return static_cast<size_t>(p - line);
 }

@@ -114,6 +114,12 @@ long long json_integer(const nlohmann::json& j, const char* key);
 
 // The trajectory columns, in file order.
 const std::vector<std::string>& trajectory_columns();
+inline constexpr size_t kTrajectoryColumns = 27;
+// One sample's values in trajectory_columns() order into `values` (kTrajectoryColumns of them):
+// the one list of what a row holds, for the CSV text and for columns kept as numbers (the
+// Python module's arrays). "surface" holds its Surface code; an engine contact point the engine
+// did not report is NaN.
+void trajectory_row_values(const Observation& o, double* values);
 
 // Writes trajectory.csv: numbers with 17 significant digits (nan for an engine contact point
 // the engine did not report), surface as text. Rows go to `path.tmp.PID`; commit() renames it

@@ -7,6 +7,7 @@
 
 #include "registry.h"
 #include "measure/classify.h"
+#include "io/interrupt.h"
 #include "io/json_fields.h"
 #include "io/text.h"
 #include "records/records.h"
@@ -123,6 +124,8 @@ std::string compute_reference_texts(const Scene& scene) {
   try {
     auto sim = make_simulator(reference_engine().name, scene);
     record = run_simulator(*sim, scene, &sink);
+  } catch (const Interrupted&) {
+    throw;  // a stop request (the Python module's Ctrl-C) is not a failed reference
   } catch (const std::exception& e) {
     return failed_reference_text(sink.trajectory.size() ? sink.trajectory.t.back() : 0.0,
                                  "the reference run of " + scene.name + " failed: exception: " + e.what());
