@@ -59,6 +59,33 @@ EngineContactForces contact_forces(const ContactReport& r) {
 
 double Simulator::friction_work() const { return std::numeric_limits<double>::quiet_NaN(); }
 
+double EnergyLedgerTotals::accounted() const {
+  auto or0 = [](double v) { return std::isfinite(v) ? v : 0.0; };
+  return or0(normal_work) + or0(friction_work) + or0(drilling_work) - or0(impact_energy);
+}
+
+EnergyLedgerTotals StepChecks::energy_ledger() const {
+  EnergyLedgerTotals l;
+  l.normal_work = normal_work_;
+  l.friction_work = friction_work_;
+  if (has_potential_) l.elastic_energy = elastic(last_);
+  return l;
+}
+
+void StepChecks::set_contact_potential(const ContactPotential& p) {
+  has_potential_ = true;
+  potential_ = p;
+}
+
+double StepChecks::elastic(const StepProbe& p) const {
+  const double e = potential_.exponent + 1.0;
+  auto u = [&](double k, double gap) {
+    const double d = -gap - potential_.offset;
+    return d > 0 ? k / e * std::pow(d, e) : 0.0;
+  };
+  return u(potential_.k_ball, p.gap_ball) + (body_.stem ? u(potential_.k_stem, p.gap_stem) : 0.0);
+}
+
 StepChecks::StepProbe StepChecks::probe(const BodyState& x) const {
   StepProbe p;
   p.state = x;
@@ -133,14 +160,20 @@ void StepChecks::add_friction_work(const BodyState& y, double h, const ContactRe
   // the step ends with (a sticking contact ends at v_C = 0 and does no work): the end state's
   // material-point velocity at the force's point (the geometric contact point when the engine
   // gave none).
+  // The normal force's work is booked the same way (F_n times the point's velocity along +z):
+  // with the semi-implicit (symplectic) Euler step of the fixed-step engines, x_{n+1} - x_n =
+  // v_{n+1} h, so F_n v_{n+1} h is the work of F_n along the step's displacement.
   const Vec3 w_W = y.q_WB * y.w_B;
   for (const Surface s : {Surface::Ball, Surface::Stem}) {
     const bool stem = s == Surface::Stem;
     const Vec3& f = stem ? c.friction_stem_W : c.friction_ball_W;
-    if (f.isZero(0.0) || (stem && !body_.stem)) continue;
+    const double f_n = stem ? c.normal_force_stem : c.normal_force_ball;
+    if ((f.isZero(0.0) && f_n == 0.0) || (stem && !body_.stem)) continue;
     const double weight = stem ? c.weight_stem : c.weight_ball;
     const Vec3 r = weight > 0 ? Vec3((stem ? c.p_WC_stem : c.p_WC_ball) - y.p_WG) : contact_offset_W(body_, y.q_WB, s);
-    friction_work_ += f.dot(y.v_WG + w_W.cross(r)) * h;
+    const Vec3 v_C = y.v_WG + w_W.cross(r);
+    friction_work_ += f.dot(v_C) * h;
+    normal_work_ += f_n * v_C.z() * h;
   }
 }
 

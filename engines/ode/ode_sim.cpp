@@ -251,6 +251,13 @@ OdeSimulator::OdeSimulator(const Scene& scene)
   contacts_.resize(n_geoms * static_cast<size_t>(settings_.max_contacts));
   scratch_.resize(static_cast<size_t>(settings_.max_contacts));
 
+  // The contact normal row's spring (ODE's equivalence k_p = erp / (h cfm), acting on the depth
+  // beyond the surface layer): the elastic energy of the energy ledger.
+  ContactPotential spring;
+  spring.k_ball = spring.k_stem = settings_.soft_erp / (settings_.timestep * settings_.soft_cfm);
+  spring.exponent = 1.0;
+  spring.offset = settings_.surface_layer;
+  checks_.set_contact_potential(spring);
   start(settings_.timestep);
 }
 
