@@ -183,6 +183,7 @@ SimbodySimulator::SimbodySimulator(const Scene& scene)
   hertz.k_stem = m.stem ? 4.0 / 3.0 * E_eff * std::sqrt(m.r) : 0.0;
   hertz.exponent = 1.5;
   checks_.set_contact_potential(hertz);
+  checks_.set_smooth_forces();
   checks_.start(read_state(integ_->getState()));
   report_ = read_contacts(integ_->getState());
   make_notes();
