@@ -117,7 +117,8 @@ class Simulator {
   virtual EngineContactForces contact_forces() const { return {}; }
   // The work of the friction forces of contact_forces() over the run so far: per step, F_t . v_C
   // times the step at each surface, v_C the velocity of the top's material point at the force's
-  // point at the end of the step. NaN where the simulator reports no contact forces.
+  // point, the mean of the step's start and end (exact for an impulse; docs/energy-ledger.md).
+  // NaN where the simulator reports no contact forces.
   virtual double friction_work() const;
   // The energy ledger of the run so far (EnergyLedgerTotals). The default: nothing available.
   virtual EnergyLedgerTotals energy_ledger() const { return {}; }

@@ -74,8 +74,8 @@ class StepChecks {
   // The engine's contact law has a potential (ContactPotential); call before start().
   void set_contact_potential(const ContactPotential& p);
   // The engine's contact forces are a smooth law read at each step's end (Simbody), not a
-  // solver's impulse over the step: the ledger integrates their power by the trapezoid rule
-  // instead of the impulse's exact work (the force times the step's mean point velocity).
+  // solver's impulse over the step: the ledger books their power at the step's end times the
+  // step instead of the impulse's exact work (the force times the step's mean point velocity).
   void set_smooth_forces() { smooth_forces_ = true; }
   // A state set from outside: the probes restart from it, so no crossing is found across the jump.
   void restart(const BodyState& x);
@@ -122,7 +122,6 @@ class StepChecks {
   bool inverted_ = false, stem_touched_ = false;
   double friction_work_ = 0.0, normal_work_ = 0.0;
   bool smooth_forces_ = false;
-  double power_t_[2] = {0.0, 0.0}, power_n_[2] = {0.0, 0.0};  // per surface, at the last step's end
   bool has_potential_ = false;
   ContactPotential potential_;
   double elastic(const StepProbe& p) const;
