@@ -179,13 +179,17 @@ void StepChecks::add_friction_work(const BodyState& y, double h, const ContactRe
     if (smooth_forces_) {
       // A force law read at the step's end (Simbody): its power there times the step. (The
       // trapezoid of the power at the step's two ends was measured further from the work the
-      // bench applied on toy_viscous, 1.1e-3 relative against 1e-4, and from the energy error
+      // bench applied on toy_viscous, 1.1e-3 relative against 1.1e-5, and from the energy error
       // on the frictionless top: test_contact_forces.cpp, test_energy_ledger.cpp.)
       friction_work_ += f.dot(v_end) * h;
       normal_work_ += f_n * v_end.z() * h;
       continue;
     }
-    const Vec3 v_C = 0.5 * (v_end + x.v_WG + w0_W.cross(r));
+    // At the start the force's point is where the contact was then: a rolling top's contact
+    // point moves over its surface (by ~w h R a step), so the start's point is the start state's
+    // geometric contact point shifted as the engine's point is from the end's.
+    const Vec3 r0 = r + contact_offset_W(body_, x.q_WB, s) - contact_offset_W(body_, y.q_WB, s);
+    const Vec3 v_C = 0.5 * (v_end + x.v_WG + w0_W.cross(r0));
     friction_work_ += f.dot(v_C) * h;
     normal_work_ += f_n * v_C.z() * h;
   }
