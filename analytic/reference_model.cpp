@@ -76,14 +76,17 @@ ContactForces ReferenceModel::Impl::forces_at_noted(const StateVector& y) {
 
 // Power of the contact forces and torques on the body (<= 0 for a dissipative law; the
 // normal force's share is its work on the drift of a held contact, tolerance-sized).
-double ReferenceModel::Impl::contact_power(const StateVector& y) {
+// Per part: (normal force along +z, tangential force, drilling torque), for the energy ledger's split.
+Vec3 ReferenceModel::Impl::contact_power(const StateVector& y) {
   const ContactForces f = forces_at(y, mode);
   const BodyState x = unpack(y, 0);
   const double wz = (x.q_WB.normalized() * x.w_B).z();
-  double p = 0.0;
+  Vec3 p = Vec3::Zero();
   for (int s = 0; s < 2; ++s) {
     if (!mode.slot[s].active) continue;
-    p += f.force_W[s].dot(dyn.contact_velocity(x, s)) + f.drill_torque[s] * wz;
+    const Vec3 v = dyn.contact_velocity(x, s);
+    const Vec3& F = f.force_W[s];
+    p += Vec3(F.z() * v.z(), F.x() * v.x() + F.y() * v.y(), f.drill_torque[s] * wz);
   }
   return p;
 }
@@ -92,22 +95,29 @@ double ReferenceModel::Impl::contact_power(const StateVector& y) {
 // (exact to degree 9). Every mode change ends an interval, so the power is smooth on it;
 // measured against E(t) the ledger closes to ~1e-11 E0 (dopri5) and ~7e-10 E0 (bulirsch_stoer,
 // whose own energy error near the end of a graze is that size, see GrazePinch).
-double ReferenceModel::Impl::gauss5(double a, double b) {
+Vec3 ReferenceModel::Impl::gauss5(double a, double b) {
   static constexpr double xg[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
   static constexpr double wg[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665, 0.2369268850561891};
   const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
-  double sum = 0.0;
+  Vec3 sum = Vec3::Zero();
   for (int i = 0; i < 5; ++i) sum += wg[i] * contact_power(state_at(mid + half * xg[i]));
   return half * sum;
 }
 
-double ReferenceModel::Impl::friction_work(double a, double b) {
-  if (!(b > a) || !mode.any_active()) return 0.0;
+Vec3 ReferenceModel::Impl::friction_work(double a, double b) {
+  if (!(b > a) || !mode.any_active()) return Vec3::Zero();
   return -gauss5(a, b);
 }
 
+void EnergyLedger::add_contact_work(const Vec3& against) {
+  friction += against.sum();
+  normal += against.x();
+  tangential += against.y();
+  drilling += against.z();
+}
+
 void ReferenceModel::Impl::accumulate_friction_work(double a, double b) {
-  ledger.friction += friction_work(a, b);
+  ledger.add_contact_work(friction_work(a, b));
   ledger_t = b;
 }
 
@@ -405,7 +415,7 @@ EnergyLedger ReferenceModel::energy_ledger() const {
   Impl& m = *impl_;
   if (!m.ledger_obs_valid) {
     m.ledger_obs = m.ledger;
-    if (status_ == ReferenceStatus::Ok && t_obs_ < m.ledger_t) m.ledger_obs.friction -= m.friction_work(t_obs_, m.ledger_t);
+    if (status_ == ReferenceStatus::Ok && t_obs_ < m.ledger_t) m.ledger_obs.add_contact_work(-m.friction_work(t_obs_, m.ledger_t));
     m.ledger_obs_valid = true;
   }
   return m.ledger_obs;

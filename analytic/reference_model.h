@@ -27,11 +27,16 @@ struct ReferenceEvent {
 // so that E(t) + total() = E0 up to the integration error.
 struct EnergyLedger {
   double friction = 0.0;     // work done against the contact forces: -int sum_s F_s . v_C + tau_s w_z dt
+  // Its parts: the normal force (F_z v_C.z, the drift of a held contact), the tangential force
+  // and the drilling torque; friction = normal + tangential + drilling.
+  double normal = 0.0, tangential = 0.0, drilling = 0.0;
   double impacts = 0.0;      // removed by touchdown impacts (the impact events' values)
   double holds = 0.0;        // removed where a Zeno cascade of impacts is closed (hold events)
   double projections = 0.0;  // removed by the two-contact projection at restarts (projection events)
   double drift = 0.0;        // changed by the one-contact drift correction at restarts (tolerance-sized)
   double total() const { return friction + impacts + holds + projections + drift; }
+  // Books work done against the contact forces, per part (normal, tangential, drilling).
+  void add_contact_work(const Vec3& against);
 };
 
 enum class ReferenceStatus { Ok, ContactLost, Failed };

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <limits>
 
 namespace tippe {
 
@@ -34,6 +35,16 @@ struct Observation {
   double energy = 0.0;             // E = M v_G^2/2 + w.I w/2 + M g z_G
   double jellett = 0.0;            // J = L_G . R_C
   double contact_latitude = 0.0;   // angle on the ball from its south pole (-e_Z) to the contact
+  // The run's energy ledger at this sample (Simulator::energy_ledger, filled by the harness's run
+  // loop; NaN where the simulator cannot give a term): work of the normal force, of the friction
+  // force and of the drilling torque on the top, energy removed at impacts, elastic energy in
+  // the contact, and the numerical remainder E - E0 - work + impacts.
+  double normal_work = std::numeric_limits<double>::quiet_NaN();
+  double friction_work = std::numeric_limits<double>::quiet_NaN();
+  double drilling_work = std::numeric_limits<double>::quiet_NaN();
+  double impact_energy = std::numeric_limits<double>::quiet_NaN();
+  double elastic_energy = std::numeric_limits<double>::quiet_NaN();
+  double numerical_energy = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace tippe

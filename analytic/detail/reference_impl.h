@@ -165,10 +165,10 @@ struct ReferenceModel::Impl {
 
   ContactForces forces_at_noted(const StateVector& y);
 
-  double contact_power(const StateVector& y);
+  Vec3 contact_power(const StateVector& y);
 
-  double gauss5(double a, double b);
-  double friction_work(double a, double b);
+  Vec3 gauss5(double a, double b);
+  Vec3 friction_work(double a, double b);
   void accumulate_friction_work(double a, double b);
 
   double gap_acceleration(const StateVector& y, const ContactMode& m, int k);

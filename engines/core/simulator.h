@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -67,6 +68,23 @@ struct EngineContactForces {
   Vec3 friction_W() const { return ball.f_t_W + stem.f_t_W; }
 };
 
+// A run's energy ledger so far (docs/energy-ledger.md): the work the contact forces did on the top
+// (positive: energy given to it), the energy removed at impacts, the energy stored in a soft
+// contact. NaN marks a term the simulator cannot give (never a made-up number): an engine whose
+// contact stores energy by a law the bench cannot evaluate, torques an engine does not report,
+// impacts an engine resolves inside its normal force. E(t) - E0 - (normal + friction + drilling
+// work) + impact_energy is the simulator's numerical energy (integrator, constraint stabilization;
+// NaN terms count as 0 there, and the record says which were not available).
+struct EnergyLedgerTotals {
+  double normal_work = std::numeric_limits<double>::quiet_NaN();    // F_n v_C.n h summed
+  double friction_work = std::numeric_limits<double>::quiet_NaN();  // F_t . v_C h summed
+  double drilling_work = std::numeric_limits<double>::quiet_NaN();  // torques about the normal and rolling torques . w h
+  double impact_energy = std::numeric_limits<double>::quiet_NaN();  // removed at impacts (>= 0)
+  double elastic_energy = std::numeric_limits<double>::quiet_NaN(); // stored in the soft contact now (>= 0)
+  // The work terms and impacts as counted in the numerical energy (NaN as 0).
+  double accounted() const;
+};
+
 // Ordered key=value pairs of every setting that decides accuracy, as used in the run.
 using SettingsList = std::vector<std::pair<std::string, std::string>>;
 
@@ -99,8 +117,11 @@ class Simulator {
   virtual EngineContactForces contact_forces() const { return {}; }
   // The work of the friction forces of contact_forces() over the run so far: per step, F_t . v_C
   // times the step at each surface, v_C the velocity of the top's material point at the force's
-  // point at the end of the step. NaN where the simulator reports no contact forces.
+  // point, the mean of the step's start and end (exact for an impulse; docs/energy-ledger.md).
+  // NaN where the simulator reports no contact forces.
   virtual double friction_work() const;
+  // The energy ledger of the run so far (EnergyLedgerTotals). The default: nothing available.
+  virtual EnergyLedgerTotals energy_ledger() const { return {}; }
   // Notes on approximations in force (e.g. "rolling approximated by mu = 1e3").
   virtual std::vector<std::string> notes() const { return {}; }
 };

@@ -2,6 +2,7 @@
 // step budget, the event probes (inversion, first stem contact, contact surface switches).
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,17 @@ struct ContactReport {
   Vec3 friction_ball_W = Vec3::Zero(), friction_stem_W = Vec3::Zero();
   Vec3 p_WC_ball = Vec3::Zero(), p_WC_stem = Vec3::Zero();
   double weight_ball = 0.0, weight_stem = 0.0;  // the positive F_n summed into each point
+};
+
+// The potential an engine's soft contact law gives its normal force as a function of the
+// penetration depth d of a surface (the elastic part of the law, its damping left out):
+// U(d) = k_s / (p + 1) * max(0, d - offset)^(p + 1), i.e. the spring F = k_s (d - offset)^p.
+// An adapter whose engine has such a law sets it (StepChecks::set_contact_potential); for the
+// others the elastic energy is not available (NaN), never guessed.
+struct ContactPotential {
+  double k_ball = 0.0, k_stem = 0.0;  // stiffness per surface
+  double exponent = 1.0;              // p: 1 a linear spring, 1.5 Hertz
+  double offset = 0.0;                // depth at which the spring starts (ODE's surface layer)
 };
 
 // Adds one engine contact point's friction force and its point to the per-surface fields of r (the
@@ -59,6 +71,12 @@ class StepChecks {
 
   // The initial state: the probes, E0 and the speed scale the limits are relative to.
   void start(const BodyState& x0);
+  // The engine's contact law has a potential (ContactPotential); call before start().
+  void set_contact_potential(const ContactPotential& p);
+  // The engine's contact forces are a smooth law read at each step's end (Simbody), not a
+  // solver's impulse over the step: the ledger books their power at the step's end times the
+  // step instead of the impulse's exact work (the force times the step's mean point velocity).
+  void set_smooth_forces() { smooth_forces_ = true; }
   // A state set from outside: the probes restart from it, so no crossing is found across the jump.
   void restart(const BodyState& x);
   // After a step ending at time t in state y with the engine's contacts c: events, then the
@@ -78,6 +96,11 @@ class StepChecks {
   const BodyState& last_state() const { return last_.state; }
   // The friction work of the steps so far (Simulator::friction_work).
   double friction_work() const { return friction_work_; }
+  // The ledger of the steps so far (Simulator::energy_ledger): normal and friction work, the
+  // elastic energy at the last state where the adapter set a contact potential; drilling work
+  // and impacts are not available (the adapters report no contact torques, and an engine's
+  // impacts are inside its normal work).
+  EnergyLedgerTotals energy_ledger() const;
 
  private:
   struct StepProbe {
@@ -97,7 +120,11 @@ class StepChecks {
   std::vector<Event> events_;
   StepProbe last_;
   bool inverted_ = false, stem_touched_ = false;
-  double friction_work_ = 0.0;
+  double friction_work_ = 0.0, normal_work_ = 0.0;
+  bool smooth_forces_ = false;
+  bool has_potential_ = false;
+  ContactPotential potential_;
+  double elastic(const StepProbe& p) const;
   Surface contact_surface_ = Surface::Ball;
 };
 
@@ -118,6 +145,7 @@ class CheckedSimulator : public Simulator {
   std::vector<Event> events() const override { return checks_.events(); }
   size_t event_count() const override { return checks_.events().size(); }
   double friction_work() const override { return checks_.friction_work(); }
+  EnergyLedgerTotals energy_ledger() const override { return checks_.energy_ledger(); }
 
  protected:
   explicit CheckedSimulator(const Scene& scene) : checks_(BodyModel::from_scene(scene)) {}

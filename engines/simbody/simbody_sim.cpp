@@ -175,6 +175,15 @@ SimbodySimulator::SimbodySimulator(const Scene& scene)
   make_integrator();
   integ_->initialize(s);
 
+  // Hertz's law F_n = (4/3) E_eff sqrt(R_s) x^(3/2) without its Hunt-Crossley damping: the
+  // elastic energy of the energy ledger (simbody_settings.h gives E_eff).
+  const double E_eff = settings_.stiffness / std::pow(2.0, 1.5);
+  ContactPotential hertz;
+  hertz.k_ball = 4.0 / 3.0 * E_eff * std::sqrt(m.R);
+  hertz.k_stem = m.stem ? 4.0 / 3.0 * E_eff * std::sqrt(m.r) : 0.0;
+  hertz.exponent = 1.5;
+  checks_.set_contact_potential(hertz);
+  checks_.set_smooth_forces();
   checks_.start(read_state(integ_->getState()));
   report_ = read_contacts(integ_->getState());
   make_notes();

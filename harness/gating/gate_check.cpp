@@ -41,6 +41,9 @@ std::string absent_reason(const std::string& metric, const Metrics& m) {
     return "a record written before the event sequences were aligned";
   if (metric == "jellett_drift_ball") return "the engine never rolled on the ball";
   if (metric == "jellett_drift_stem") return "the engine never rolled on the stem";
+  if (metric == "numerical_energy_max" || metric == "numerical_energy_final" || metric == "friction_work" ||
+      metric == "normal_work" || metric == "elastic_energy_max")
+    return "the energy ledger: not available for this engine, or a record written before the ledger";
   return "not computed";
 }
 

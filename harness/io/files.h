@@ -20,9 +20,9 @@ class OutputError : public std::runtime_error {
 // kMaxSweepPoints (sweep.h) = 1e5 points, ~300 MB; 1 GiB leaves room and still fits in memory.
 constexpr size_t kMaxInputFileBytes = size_t{1} << 20;
 constexpr size_t kMaxRecordFileBytes = size_t{1} << 30;
-// The longest row of trajectory.csv (27 columns of at most 32 characters): scene files bound their
+// The longest row of trajectory.csv (33 columns of at most 32 characters): scene files bound their
 // sample count by it, so that no trajectory outgrows kMaxRecordFileBytes.
-constexpr size_t kTrajectoryRowMax = 27 * 32;
+constexpr size_t kTrajectoryRowMax = 33 * 32;
 
 // Writes `text` to `path.tmp.PID`, fsyncs it and renames it over `path`, so readers see the old
 // file or the new one, never a part. Throws OutputError (temporary removed) on failure.

@@ -102,17 +102,40 @@ double contact_energy_allowance(const Scene& scene) {
   return std::isfinite(a) && a > 0 ? a : 0.0;
 }
 
-EnergyGains energy_gains(const Trajectory& tr, double allowance) {
+const char* to_string(EnergyGainRule r) { return r == EnergyGainRule::Ledger ? "ledger" : "total"; }
+
+std::vector<double> energy_counted(const Trajectory& tr, EnergyGainRule rule) {
+  if (rule == EnergyGainRule::Total || tr.numerical_energy.size() != tr.size()) return tr.energy;
+  std::vector<double> c(tr.size());
+  const double e0 = tr.size() ? tr.energy[0] : 0.0;
+  const bool store = tr.elastic_energy.size() == tr.size() && tr.normal_work.size() == tr.size();
+  const double u0 = store && tr.size() && std::isfinite(tr.elastic_energy[0]) ? tr.elastic_energy[0] : 0.0;
+  for (size_t k = 0; k < tr.size(); ++k) {
+    const double n = tr.numerical_energy[k];
+    if (!std::isfinite(n)) {
+      c[k] = tr.energy[k];  // no ledger at this sample: the total
+      continue;
+    }
+    // With the elastic energy: C = N + (normal work + U - U0), the part of the normal force's
+    // work its store does not explain; without: N.
+    const double u = store ? tr.elastic_energy[k] : kNaN, wn = store ? tr.normal_work[k] : kNaN;
+    c[k] = e0 + n + (std::isfinite(u) && std::isfinite(wn) ? wn + u - u0 : 0.0);
+  }
+  return c;
+}
+
+EnergyGains energy_gains(const Trajectory& tr, double allowance, EnergyGainRule rule) {
   EnergyGains g;
   if (tr.size() < 2) return g;
-  const double e0 = std::abs(tr.energy[0]);
+  const std::vector<double> energy = energy_counted(tr, rule);
+  const double e0 = std::abs(energy[0]);
   const double scale = e0 > 0 ? e0 : 1.0;
   const double threshold = kEnergyGainTolerance * scale + allowance;
   g.tolerance = threshold / scale;
-  double low = tr.energy[0], low_t = tr.t[0];
+  double low = energy[0], low_t = tr.t[0];
   bool above = false;
   for (size_t k = 1; k < tr.size(); ++k) {
-    const double e = tr.energy[k];
+    const double e = energy[k];
     if (!std::isfinite(e)) break;  // a divergence, which the class reports on its own
     const double rise = e - low;
     if (rise > threshold) {
@@ -222,8 +245,9 @@ Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, con
   if (engine_traj.size()) {
     const double E0 = engine_traj.energy.front();
     m.energy_final_ratio = engine_traj.energy.back() / E0;
+    m.energy_gain_rule = to_string(kDefaultEnergyGainRule);
     if (energy_must_not_rise(scene)) {
-      const EnergyGains g = energy_gains(engine_traj, contact_energy_allowance(scene));
+      const EnergyGains g = energy_gains(engine_traj, contact_energy_allowance(scene), kDefaultEnergyGainRule);
       m.energy_gain_events = g.events;
       m.energy_max_gain = g.events ? g.max_rise : 0.0;
     }
@@ -231,6 +255,19 @@ Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, con
     m.energy_final_ratio = kNaN;
   }
 
+  // The ledger's totals, / |E0| of the engine's run (absolute when E0 = 0).
+  const double e_run = std::isfinite(engine.energy_initial) && engine.energy_initial != 0 ? std::abs(engine.energy_initial) : 1.0;
+  auto ledger = [&](double v) -> std::optional<double> {
+    if (!std::isfinite(v)) return std::nullopt;
+    return v / e_run;
+  };
+  m.normal_work = ledger(engine.normal_work);
+  m.friction_work = ledger(engine.friction_work);
+  m.drilling_work = ledger(engine.drilling_work);
+  m.impact_energy = ledger(engine.impact_energy);
+  m.elastic_energy_max = ledger(engine.elastic_energy_max);
+  m.numerical_energy_max = ledger(engine.numerical_energy_max);
+  m.numerical_energy_final = ledger(engine.numerical_energy_final);
   m.jellett_drift_ball = engine.jellett_drift_ball;
   m.jellett_drift_stem = engine.jellett_drift_stem;
   m.jellett_max_relative_drift = engine.jellett_max_relative_drift;

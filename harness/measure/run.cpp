@@ -39,12 +39,18 @@ RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, Pr
   size_t events_seen = 0;
   auto emit = [&](const Observation& o) {
     // The list is copied only when it grew: most samples see no new event.
-    bool switched = false;
+    bool switched = false, inverted = false;
     if (sim.event_count() != events_seen) {
       const std::vector<Event> events = sim.events();
-      for (size_t i = events_seen; i < events.size(); ++i) switched = switched || events[i].name == "switch";
+      for (size_t i = events_seen; i < events.size(); ++i) {
+        switched = switched || events[i].name == "switch";
+        inverted = inverted || events[i].name == "inversion";
+      }
       events_seen = events.size();
     }
+    if (inverted && !r.ledger_at_inversion && std::isfinite(o.numerical_energy))
+      r.ledger_at_inversion = RunRecord::LedgerPoint{o.state.t,       o.energy,        o.normal_work,     o.friction_work,
+                                                     o.drilling_work, o.impact_energy, o.numerical_energy};
     summary.add(o, switched);
     if (sink) sink->write(o);
     last_t = o.state.t;
@@ -54,12 +60,20 @@ RunRecord run_simulator(Simulator& sim, const Scene& scene, SampleSink* sink, Pr
   };
   // The run's clocks: read here and after the loop only (see WorkCounters).
   const SpanTimer timer;
-  emit(sim.observe());
+  // Every sample carries the energy ledger at its time (E0: the first sample's energy).
+  double e0 = 0.0;
+  auto observe = [&](bool first) {
+    Observation o = sim.observe();
+    if (first) e0 = o.energy;
+    fill_ledger(o, sim.energy_ledger(), e0);
+    return o;
+  };
+  emit(observe(true));
   for (long long k = 1; k <= n && sim.status() == RunStatus::Ok; ++k) {
     double t = static_cast<double>(k) * dt;
     if (k == n && std::abs(t - T) <= 1e-9 * dt) t = T;
     sim.advance_to(t);
-    const Observation o = sim.observe();
+    const Observation o = observe(false);
     // A simulator that stopped may report the state it stopped at, which can repeat the last sample.
     if (sim.status() == RunStatus::Ok || o.state.t > last_t) emit(o);
   }

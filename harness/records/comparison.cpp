@@ -6,6 +6,7 @@
 #include <limits>
 #include <set>
 #include <tuple>
+#include <utility>
 #include <stdexcept>
 #include "io/json_fields.h"
 #include "io/scene_io.h"
@@ -108,6 +109,14 @@ json to_json(const Metrics& m) {
       {"energy_final_ratio", number(m.energy_final_ratio)},
       {"energy_gain_events", m.energy_gain_events},
       {"energy_max_gain", number(m.energy_max_gain)},
+      {"energy_gain_rule", m.energy_gain_rule},
+      {"normal_work", number(m.normal_work)},
+      {"friction_work", number(m.friction_work)},
+      {"drilling_work", number(m.drilling_work)},
+      {"impact_energy", number(m.impact_energy)},
+      {"elastic_energy_max", number(m.elastic_energy_max)},
+      {"numerical_energy_max", number(m.numerical_energy_max)},
+      {"numerical_energy_final", number(m.numerical_energy_final)},
       {"contact_path_rms_error", number(m.contact_path_rms_error)},
       {"contact_path_max_error", number(m.contact_path_max_error)},
       {"com_path_rms_error", number(m.com_path_rms_error)},
@@ -152,6 +161,21 @@ Metrics metrics_from_json(const json& j) {
   m.energy_final_ratio = get_number(j, "energy_final_ratio");
   m.energy_gain_events = json_integer(j, "energy_gain_events");
   m.energy_max_gain = get_number(j, "energy_max_gain");
+  // The rule and the ledger are absent in records written before them.
+  if (j.contains("energy_gain_rule")) {
+    m.energy_gain_rule = j.at("energy_gain_rule").get<std::string>();
+    if (m.energy_gain_rule != "ledger" && m.energy_gain_rule != "total")
+      throw std::invalid_argument("metrics.energy_gain_rule: \"" + m.energy_gain_rule + "\" is not ledger or total");
+  }
+  const std::pair<const char*, std::optional<double>*> ledger[] = {{"normal_work", &m.normal_work},
+                                                                    {"friction_work", &m.friction_work},
+                                                                    {"drilling_work", &m.drilling_work},
+                                                                    {"impact_energy", &m.impact_energy},
+                                                                    {"elastic_energy_max", &m.elastic_energy_max},
+                                                                    {"numerical_energy_max", &m.numerical_energy_max},
+                                                                    {"numerical_energy_final", &m.numerical_energy_final}};
+  for (const auto& [key, field] : ledger)
+    if (j.contains(key)) *field = get_optional(j, key);
   m.contact_path_rms_error = get_number(j, "contact_path_rms_error");
   m.contact_path_max_error = get_number(j, "contact_path_max_error");
   m.com_path_rms_error = get_number(j, "com_path_rms_error");

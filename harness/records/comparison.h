@@ -35,6 +35,13 @@ struct Metrics {
   double energy_final_ratio = 0;                              // E_final / E0 of the engine
   long long energy_gain_events = 0;                           // dissipative scenes: net rises above tolerance (metrics.h)
   double energy_max_gain = 0;                                 // largest net rise, / E0
+  // How the two above counted energy (measure/metrics.h, EnergyGainRule): "ledger" or "total";
+  // empty in records written before the rule was a setting (they counted the total).
+  std::string energy_gain_rule;
+  // The engine's energy ledger at the end of its run (RunRecord), / |E0| of the engine's run;
+  // absent (null) where the engine cannot give the term and in records written before it.
+  std::optional<double> normal_work, friction_work, drilling_work, impact_energy;
+  std::optional<double> elastic_energy_max, numerical_energy_max, numerical_energy_final;
   double contact_path_rms_error = 0, contact_path_max_error = 0;  // floor contact path, / R
   double com_path_rms_error = 0, com_path_max_error = 0;          // path of G (x, y), / R
   double latitude_rms_error = 0;                              // contact latitude on the ball, rad

@@ -19,6 +19,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "io/provenance.h"
 
@@ -54,6 +55,18 @@ Provenance current_provenance() {
   return p;
 }
 
+void fill_ledger(Observation& o, const EnergyLedgerTotals& l, double e0) {
+  o.normal_work = l.normal_work;
+  o.friction_work = l.friction_work;
+  o.drilling_work = l.drilling_work;
+  o.impact_energy = l.impact_energy;
+  o.elastic_energy = l.elastic_energy;
+  // A simulator with no ledger term at all has no numerical remainder to speak of either.
+  const bool any = std::isfinite(l.normal_work) || std::isfinite(l.friction_work) || std::isfinite(l.drilling_work) ||
+                   std::isfinite(l.impact_energy);
+  o.numerical_energy = any ? o.energy - e0 - l.accounted() : kNaN;
+}
+
 void SampleSummary::add(const Observation& o, bool contact_switched) {
   if (n_ == 0) {
     first_ = o;
@@ -62,6 +75,9 @@ void SampleSummary::add(const Observation& o, bool contact_switched) {
   last_ = o;
   min_fn_ = std::min(min_fn_, o.normal_force);
   ++n_;
+  if (std::isfinite(o.elastic_energy)) elastic_max_ = std::isnan(elastic_max_) ? o.elastic_energy : std::max(elastic_max_, o.elastic_energy);
+  if (std::isfinite(o.numerical_energy))
+    numerical_max_ = std::isnan(numerical_max_) ? std::abs(o.numerical_energy) : std::max(numerical_max_, std::abs(o.numerical_energy));
 
   if (contact_switched) run_surface_ = Surface::None;
   if (o.surface != Surface::Ball && o.surface != Surface::Stem) {
@@ -95,6 +111,18 @@ void SampleSummary::fill(RunRecord& r) const {
   r.min_normal_force = min_fn_;
   r.jellett_drift_ball = drift_ball_;
   r.jellett_drift_stem = drift_stem_;
+  r.normal_work = last_.normal_work;
+  r.drilling_work = last_.drilling_work;
+  r.impact_energy = last_.impact_energy;
+  r.elastic_energy_max = elastic_max_;
+  r.numerical_energy_max = numerical_max_;
+  r.numerical_energy_final = last_.numerical_energy;
+  r.ledger_not_available.clear();
+  const std::pair<const char*, double> terms[] = {{"normal_work", last_.normal_work},   {"friction_work", last_.friction_work},
+                                                  {"drilling_work", last_.drilling_work}, {"impact_energy", last_.impact_energy},
+                                                  {"elastic_energy", last_.elastic_energy}};
+  for (const auto& [name, v] : terms)
+    if (std::isnan(v)) r.ledger_not_available.push_back(name);
   if (drift_ball_ || drift_stem_)
     r.jellett_max_relative_drift = std::max(drift_ball_.value_or(0.0), drift_stem_.value_or(0.0));
   else
@@ -131,6 +159,21 @@ json to_json(const RunRecord& r) {
       {"jellett_drift_stem", number(r.jellett_drift_stem)},
       {"min_normal_force", number(r.min_normal_force)},
       {"friction_work", number(r.friction_work)},
+      {"normal_work", number(r.normal_work)},
+      {"drilling_work", number(r.drilling_work)},
+      {"impact_energy", number(r.impact_energy)},
+      {"elastic_energy_max", number(r.elastic_energy_max)},
+      {"numerical_energy_max", number(r.numerical_energy_max)},
+      {"numerical_energy_final", number(r.numerical_energy_final)},
+      {"ledger_not_available", r.ledger_not_available},
+      {"ledger_at_inversion", r.ledger_at_inversion ? json{{"time", number(r.ledger_at_inversion->time)},
+                                                           {"energy", number(r.ledger_at_inversion->energy)},
+                                                           {"normal_work", number(r.ledger_at_inversion->normal_work)},
+                                                           {"friction_work", number(r.ledger_at_inversion->friction_work)},
+                                                           {"drilling_work", number(r.ledger_at_inversion->drilling_work)},
+                                                           {"impact_energy", number(r.ledger_at_inversion->impact_energy)},
+                                                           {"numerical_energy", number(r.ledger_at_inversion->numerical_energy)}}
+                                                    : json(nullptr)},
       {"mass_properties",
        {{"mass", number(r.mass.mass)},
         {"com_offset", number(r.mass.com_offset)},
@@ -236,6 +279,26 @@ RunRecord from_json(const json& j) {
   r.min_normal_force = get_number(j, "min_normal_force");
   // Absent from records written before it: read as not reported.
   r.friction_work = j.contains("friction_work") ? get_number(j, "friction_work") : kNaN;
+  const std::pair<const char*, double*> ledger[] = {{"normal_work", &r.normal_work},
+                                                     {"drilling_work", &r.drilling_work},
+                                                     {"impact_energy", &r.impact_energy},
+                                                     {"elastic_energy_max", &r.elastic_energy_max},
+                                                     {"numerical_energy_max", &r.numerical_energy_max},
+                                                     {"numerical_energy_final", &r.numerical_energy_final}};
+  for (const auto& [key, field] : ledger) *field = j.contains(key) ? get_number(j, key) : kNaN;
+  if (j.contains("ledger_not_available")) r.ledger_not_available = j.at("ledger_not_available").get<std::vector<std::string>>();
+  if (j.contains("ledger_at_inversion") && !j.at("ledger_at_inversion").is_null()) {
+    const json& p = j.at("ledger_at_inversion");
+    RunRecord::LedgerPoint lp;
+    lp.time = get_number(p, "time");
+    lp.energy = get_number(p, "energy");
+    lp.normal_work = get_number(p, "normal_work");
+    lp.friction_work = get_number(p, "friction_work");
+    lp.drilling_work = get_number(p, "drilling_work");
+    lp.impact_energy = get_number(p, "impact_energy");
+    lp.numerical_energy = get_number(p, "numerical_energy");
+    r.ledger_at_inversion = lp;
+  }
   const json& m = j.at("mass_properties");
   r.mass = {get_number(m, "mass"), get_number(m, "com_offset"), get_number(m, "inertia_transverse"),
             get_number(m, "inertia_axial")};
@@ -264,7 +327,9 @@ const std::vector<std::string>& trajectory_columns() {
       "t",        "x_G",        "y_G",        "z_G",        "vx_G",         "vy_G",       "vz_G",
       "qw",       "qx",         "qy",         "qz",         "wx_B",         "wy_B",       "wz_B",
       "theta",    "surface",    "x_C",        "y_C",        "z_C",          "x_C_engine", "y_C_engine",
-      "z_C_engine", "normal_force", "slip_speed", "energy", "jellett", "contact_latitude"};
+      "z_C_engine", "normal_force", "slip_speed", "energy", "jellett", "contact_latitude",
+      // The energy ledger (Observation), NaN where not available.
+      "normal_work", "friction_work", "drilling_work", "impact_energy", "elastic_energy", "numerical_energy"};
   // trajectory_row_values fills kTrajectoryColumns values, one per name here.
   if (cols.size() != kTrajectoryColumns) throw std::logic_error("trajectory_columns and kTrajectoryColumns disagree");
   return cols;
@@ -314,6 +379,8 @@ void trajectory_row_values(const Observation& o, double* values) {
   *v++ = o.energy;
   *v++ = o.jellett;
   *v++ = o.contact_latitude;
+  for (double l : {o.normal_work, o.friction_work, o.drilling_work, o.impact_energy, o.elastic_energy, o.numerical_energy})
+    *v++ = l;
 }
 
 size_t format_trajectory_row(const Observation& o, char* line) {

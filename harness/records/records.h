@@ -72,7 +72,33 @@ struct RunRecord {
   // The work of the friction forces the simulator reported (Simulator::friction_work), scene
   // units of energy; NaN (JSON null) where it reports none, and in records written before it.
   double friction_work = std::numeric_limits<double>::quiet_NaN();
+  // The energy ledger's totals (Simulator::energy_ledger, docs/energy-ledger.md), scene units of
+  // energy, NaN (JSON null) for a term the simulator cannot give and in records written before:
+  // work of the normal force and of the drilling torque on the top, energy removed at impacts,
+  // the largest elastic energy stored in the contact, and the numerical energy N(t) = E(t) - E0 -
+  // (normal + friction + drilling work) + impacts: its largest |N| over the samples and its value
+  // at the last sample.
+  double normal_work = std::numeric_limits<double>::quiet_NaN();
+  double drilling_work = std::numeric_limits<double>::quiet_NaN();
+  double impact_energy = std::numeric_limits<double>::quiet_NaN();
+  double elastic_energy_max = std::numeric_limits<double>::quiet_NaN();
+  double numerical_energy_max = std::numeric_limits<double>::quiet_NaN();
+  double numerical_energy_final = std::numeric_limits<double>::quiet_NaN();
+  // The ledger's terms the simulator could not give (e.g. "elastic_energy"), named in the record.
+  std::vector<std::string> ledger_not_available;
+  // The ledger at the first sample at or after the first "inversion" event (what the run had
+  // spent by the time it turned over, for the report's attribution of a flip); absent when the
+  // run does not invert or has no ledger.
+  struct LedgerPoint {
+    double time = 0.0, energy = 0.0;
+    double normal_work = 0.0, friction_work = 0.0, drilling_work = 0.0, impact_energy = 0.0, numerical_energy = 0.0;
+  };
+  std::optional<LedgerPoint> ledger_at_inversion;
 };
+
+// The ledger's numbers at one sample, from the simulator's totals and the sample's energy
+// (Observation's ledger fields; e0: the run's first energy).
+void fill_ledger(Observation& o, const EnergyLedgerTotals& l, double e0);
 
 // Receives every sample of a run as it is produced, so a run's memory does not grow with its length.
 struct SampleSink {
@@ -95,6 +121,8 @@ class SampleSummary {
   Surface run_surface_ = Surface::None;  // None: not inside a run
   double run_j0_ = 0.0;
   std::optional<double> drift_ball_, drift_stem_;
+  double elastic_max_ = std::numeric_limits<double>::quiet_NaN();
+  double numerical_max_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The "format" of summary.json (schemas/run-summary.schema.json).
@@ -114,7 +142,7 @@ long long json_integer(const nlohmann::json& j, const char* key);
 
 // The trajectory columns, in file order.
 const std::vector<std::string>& trajectory_columns();
-inline constexpr size_t kTrajectoryColumns = 27;
+inline constexpr size_t kTrajectoryColumns = 33;
 // One sample's values in trajectory_columns() order into `values` (kTrajectoryColumns of them):
 // the one list of what a row holds, for the CSV text and for columns kept as numbers (the
 // Python module's arrays). "surface" holds its Surface code; an engine contact point the engine

@@ -1,6 +1,7 @@
 // A run's sampled trajectory in memory: filled from observations or from a trajectory.csv.
 #include "records/trajectory.h"
 
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -23,6 +24,15 @@ Trajectory Trajectory::from_csv(const CsvTrajectory& csv) {
   tr.x_G = csv.column("x_G");
   tr.y_G = csv.column("y_G");
   tr.surface = csv.surface;
+  auto optional_column = [&](const char* name) {
+    return csv.values.count(name) ? csv.column(name) : std::vector<double>(tr.t.size(), std::nan(""));
+  };
+  tr.normal_work = optional_column("normal_work");
+  tr.friction_work = optional_column("friction_work");
+  tr.drilling_work = optional_column("drilling_work");
+  tr.impact_energy = optional_column("impact_energy");
+  tr.elastic_energy = optional_column("elastic_energy");
+  tr.numerical_energy = optional_column("numerical_energy");
   return tr;
 }
 
@@ -39,6 +49,12 @@ void Trajectory::append(const Observation& o) {
   x_G.push_back(o.state.p_WG.x());
   y_G.push_back(o.state.p_WG.y());
   surface.push_back(static_cast<int>(o.surface));
+  normal_work.push_back(o.normal_work);
+  friction_work.push_back(o.friction_work);
+  drilling_work.push_back(o.drilling_work);
+  impact_energy.push_back(o.impact_energy);
+  elastic_energy.push_back(o.elastic_energy);
+  numerical_energy.push_back(o.numerical_energy);
 }
 
 void TrajectorySink::write(const Observation& o) {

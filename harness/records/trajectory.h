@@ -11,6 +11,8 @@ namespace tippe {
 struct Trajectory {
   std::vector<double> t, theta, energy, jellett, normal_force, slip_speed, contact_latitude;
   std::vector<double> x_C, y_C, x_G, y_G;
+  // The energy ledger (Observation's fields); all NaN for a trajectory written before them.
+  std::vector<double> normal_work, friction_work, drilling_work, impact_energy, elastic_energy, numerical_energy;
   std::vector<int> surface;  // Surface codes
   static Trajectory from_csv(const CsvTrajectory& csv);
   void append(const Observation& o);

@@ -13,6 +13,7 @@
 #include "measure/compare.h"
 #include "records/records.h"
 #include "report/compare_events.h"
+#include "report/compare_ledger.h"
 #include "report/report_text.h"
 
 namespace tippe {
@@ -286,7 +287,8 @@ std::vector<std::string> report_findings(const json& c) {
     }
     const long long gains = m.value("energy_gain_events", 0LL);
     if (gains > 0)
-      out.push_back(engine + ": energy rose above its lowest earlier value " + std::to_string(gains) + " time" +
+      out.push_back(engine + ": energy " + (str(m, "energy_gain_rule") == "ledger" ? "created (energy_gain_rule = ledger) " : "") +
+                    "rose above its lowest earlier value " + std::to_string(gains) + " time" +
                     (gains == 1 ? "" : "s") + " by more than " + fmt(kEnergyGainTolerance, "%g") +
                     " E0 and the energy of 1e-4 R of contact depth (largest net rise " + fmt(num(m, "energy_max_gain"), "%.3g") +
                     " E0) although the contact law dissipates");
@@ -373,6 +375,12 @@ std::vector<std::string> verdict_sentences(const json& c) {
               : "its run ended early (" + ended_text(s) + ") without inverting; the reference does not invert to t = " +
                     run_time_text(ref) + ".";
     }
+    // Where the engine deviates (another regime, an early end, or an inversion time off by more
+    // than the report's 1 % green band), the verdict names where its energy went.
+    const double rel = num(m, "inversion_time_rel_error");
+    const bool deviates = !ok || ref_inverts != inverts || (std::isfinite(rel) && std::abs(rel) > 0.01);
+    if (deviates)
+      if (const std::string cause = ledger_cause_sentence(c, e); !cause.empty()) t += " Energy: " + cause;
     out.push_back(t);
   }
   return out;
@@ -416,6 +424,7 @@ Document comparison_document(const json& c, const std::vector<std::string>& plot
          "note");
   d.table(doc_table(detail_table(c), "detail"), "More metrics", true);
   add_event_sequences(d, c);
+  add_energy_ledger(d, c);
 
   d.heading(2, "Findings");
   const auto findings = report_findings(c);

@@ -468,6 +468,34 @@ TEST(Records, FrictionWorkRoundTripsAndOldSummariesReadWithoutIt) {
   EXPECT_TRUE(to_json(from_json(j)).at("friction_work").is_null());
 }
 
+// The energy ledger's totals round-trip; a summary written before them reads them as not
+// available (NaN, no list of missing terms).
+TEST(Records, EnergyLedgerRoundTripsAndOldSummariesReadWithoutIt) {
+  RunRecord r = example_record();
+  r.normal_work = 1.5e-3;
+  r.impact_energy = 0.25;
+  r.elastic_energy_max = 2e-7;
+  r.numerical_energy_max = 3e-6;
+  r.numerical_energy_final = -2e-6;
+  r.ledger_not_available = {"drilling_work"};
+  nlohmann::json j = to_json(r);
+  const RunRecord back = from_json(j);
+  EXPECT_EQ(back.normal_work, 1.5e-3);
+  EXPECT_EQ(back.impact_energy, 0.25);
+  EXPECT_EQ(back.elastic_energy_max, 2e-7);
+  EXPECT_EQ(back.numerical_energy_max, 3e-6);
+  EXPECT_EQ(back.numerical_energy_final, -2e-6);
+  EXPECT_TRUE(std::isnan(back.drilling_work));
+  EXPECT_EQ(back.ledger_not_available, std::vector<std::string>{"drilling_work"});
+  for (const char* k : {"normal_work", "drilling_work", "impact_energy", "elastic_energy_max", "numerical_energy_max",
+                        "numerical_energy_final", "ledger_not_available"})
+    j.erase(k);
+  const RunRecord old = from_json(j);
+  EXPECT_TRUE(std::isnan(old.normal_work));
+  EXPECT_TRUE(std::isnan(old.numerical_energy_max));
+  EXPECT_TRUE(old.ledger_not_available.empty());
+}
+
 bool has_temporaries(const fs::path& dir) {
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().filename().string().find(".tmp.") != std::string::npos) return true;

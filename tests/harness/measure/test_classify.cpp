@@ -156,6 +156,53 @@ TEST(Classify, TheEnergyRuleDoesNotDependOnTheSampleInterval) {
     EXPECT_EQ(classify_run(viscous_scene(), ok_run(), nullptr, *tr).kind, RunClassKind::Unphysical);
 }
 
+// A run whose E rises by 1e-3 E0 over t = 0.5 .. 1.0 while its ledger books `booked` of it
+// (normal work with the contact's elastic energy falling by as much, or nothing).
+Trajectory ledger_trajectory(bool with_store, double booked) {
+  Trajectory tr;
+  for (int k = 0; k <= 10; ++k) {
+    Observation o;
+    o.state.t = 0.1 * k;
+    const double rise = k > 5 ? 1e-3 * 10.0 * (k - 5) / 5.0 : 0.0;
+    o.energy = 10.0 + rise;
+    o.surface = Surface::Ball;
+    o.normal_work = booked * rise;
+    o.friction_work = 0.0;
+    o.elastic_energy = with_store ? 0.02 - booked * rise : std::nan("");
+    o.numerical_energy = o.energy - 10.0 - o.normal_work;
+    tr.append(o);
+  }
+  return tr;
+}
+
+TEST(Classify, LedgerRuleDoesNotCountEnergyReleasedFromTheContactsStore) {
+  // The rise is the soft contact giving back what it stored (normal work = -dU): energy moved,
+  // none created. Under the ledger rule no gain; under the total rule the same run gains.
+  const Trajectory tr = ledger_trajectory(true, 1.0);
+  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Ledger).events, 0);
+  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Total).events, 1);
+}
+
+TEST(Classify, LedgerRuleCountsEnergyTheLedgerCannotExplain) {
+  // The same rise with nothing booked: numerical energy, created by the integrator; a gain under
+  // both rules, and the class says which rule counted it.
+  const Trajectory tr = ledger_trajectory(true, 0.0);
+  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Ledger).events, 1);
+  EXPECT_NEAR(energy_gains(tr, 0.0, EnergyGainRule::Ledger).max_rise, 1e-3, 1e-12);
+  const RunClass c = classify_run(viscous_scene(), ok_run(), nullptr, tr);
+  EXPECT_EQ(c.kind, RunClassKind::Unphysical);
+  EXPECT_NE(c.reason.find(std::string("energy_gain_rule = ") + to_string(kDefaultEnergyGainRule)), std::string::npos)
+      << c.reason;
+}
+
+TEST(Classify, LedgerRuleWithoutTheElasticEnergyCountsNormalWorkAsExchange) {
+  // Where the engine's contact law gives no elastic energy (n/a), the normal force's work is
+  // counted as an exchange with the contact's store: the rise it explains is not a gain.
+  const Trajectory tr = ledger_trajectory(false, 1.0);
+  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Ledger).events, 0);
+  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Total).events, 1);
+}
+
 TEST(Classify, JitterBelowTheToleranceNeverAddsUp) {
   // 10000 samples of a falling energy with +-0.4e-6 E0 of jitter: many rises between samples,
   // none a net rise above the tolerance, however long the run.

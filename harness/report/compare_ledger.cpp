@@ -1,0 +1,153 @@
+// The energy-ledger section of the comparison report: each run's account of its energy and the dominant cause of an engine's loss.
+#include "report/compare_ledger.h"
+
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "report/report_text.h"
+
+namespace tippe {
+
+namespace {
+
+using nlohmann::json;
+using namespace report_text;
+
+// The ledger's terms in a run summary, in table order, with how a sentence names them.
+struct Term {
+  const char* key;
+  const char* header;
+  const char* name;
+};
+const std::vector<Term>& terms() {
+  static const std::vector<Term> t = {{"normal_work", "normal work", "normal-force work"},
+                                      {"friction_work", "friction work", "friction work"},
+                                      {"drilling_work", "drilling work", "drilling-torque work"},
+                                      {"impact_energy", "impacts (removed)", "impacts"},
+                                      {"numerical_energy_final", "numerical (end)", "numerical"}};
+  return t;
+}
+
+bool has_ledger(const json& s) { return has_number(s, "numerical_energy_final"); }
+
+double scale_of(const json& s) {
+  const double e0 = num(s, "energy_initial");
+  return std::isfinite(e0) && e0 != 0 ? std::abs(e0) : 1.0;
+}
+
+std::string rel(const json& s, const char* key) {
+  return has_number(s, key) ? fmt(num(s, key) / scale_of(s), "%.3g") : std::string("n/a");
+}
+
+// The share of the run's energy loss E0 - E_final each term explains (impacts remove, the work
+// terms and the numerical remainder add: each enters with the sign that makes the shares sum to
+// 100 % over the available terms).
+struct Share {
+  std::string name;
+  double percent;
+};
+std::vector<Share> shares(const json& s) {
+  const double loss = num(s, "energy_initial") - num(s, "energy_final");
+  std::vector<Share> out;
+  if (!(std::isfinite(loss) && loss != 0)) return out;
+  for (const Term& t : terms()) {
+    if (!has_number(s, t.key)) continue;
+    const double v = num(s, t.key);
+    const double removed = std::string(t.key) == "impact_energy" ? v : -v;
+    out.push_back({t.name, 100.0 * removed / loss});
+  }
+  return out;
+}
+
+std::string share_text(const std::vector<Share>& sh) {
+  std::string t;
+  for (const Share& x : sh) t += (t.empty() ? "" : ", ") + fmt(x.percent, "%.3g") + " % " + x.name;
+  return t;
+}
+
+// The ledger at the engine's first inversion as a summary-like object (energy_initial and the
+// totals then), so that the same shares apply: an engine that turns over where the reference
+// does not is judged on what it had spent by its flip, not by the end of its run.
+json at_inversion(const json& s) {
+  const json& p = s.at("ledger_at_inversion");
+  json x = s;
+  x["final_time"] = p.at("time");
+  x["energy_final"] = p.at("energy");
+  for (const char* k : {"normal_work", "friction_work", "drilling_work", "impact_energy"}) x[k] = p.at(k);
+  x["numerical_energy_final"] = p.at("numerical_energy");
+  return x;
+}
+
+}  // namespace
+
+std::string ledger_cause_sentence(const json& c, const json& e) {
+  const json& s_end = e.at("summary");
+  if (!has_ledger(s_end)) return {};
+  const bool flip = s_end.contains("ledger_at_inversion") && s_end.at("ledger_at_inversion").is_object();
+  const json s = flip ? at_inversion(s_end) : s_end;
+  const json& ref = c.at("reference").at("summary");
+  const double loss = (num(s, "energy_initial") - num(s, "energy_final")) / scale_of(s);
+  const std::string t_end = fmt(num(s, "final_time"), "%.6g");
+  std::string out = "by t = " + t_end + (flip ? " (its inversion)" : "") + " its energy " +
+                    (loss >= 0 ? "fell by " + fmt(loss, "%.3g") : "rose by " + fmt(-loss, "%.3g")) + " E0";
+  if (has_ledger(ref))
+    out += " (the reference's by its end, t = " + fmt(num(ref, "final_time"), "%.6g") + ": " +
+           fmt((num(ref, "energy_initial") - num(ref, "energy_final")) / scale_of(ref), "%.3g") + " E0)";
+  const std::vector<Share> sh = shares(s);
+  if (sh.empty()) return out + ".";
+  out += "; of that change " + share_text(sh);
+  // The dominant cause: the term with the largest share of the loss (by magnitude), with the
+  // reference's friction work beside the engine's, which says whether a contact the reference
+  // keeps sticking (no friction work) did work in the engine.
+  const Share* top = &sh.front();
+  for (const Share& x : sh)
+    if (std::abs(x.percent) > std::abs(top->percent)) top = &x;
+  out += "; the dominant term: " + top->name;
+  if (has_number(s, "friction_work") && has_number(ref, "friction_work"))
+    out += " (friction work " + rel(s, "friction_work") + " E0 against the reference's " + rel(ref, "friction_work") +
+           " E0 over its whole run to t = " + fmt(num(ref, "final_time"), "%.6g") + ")";
+  const json na = s.value("ledger_not_available", json::array());
+  if (!na.empty()) {
+    std::string list;
+    for (const auto& n : na) list += (list.empty() ? "" : ", ") + n.get<std::string>();
+    out += "; not available: " + list + " (counted as 0 in the numerical remainder)";
+  }
+  return out + ".";
+}
+
+void add_energy_ledger(Document& d, const json& c) {
+  const json& ref = c.at("reference").at("summary");
+  bool any = has_ledger(ref);
+  for (const json& e : c.at("engines")) any = any || has_ledger(e.at("summary"));
+  if (!any) return;
+  d.heading(2, "Energy ledger");
+  d.para("Where each run's energy went (docs/energy-ledger.md): E_final - E0 = normal work + friction work + drilling "
+         "work - impacts + numerical, each / |E0| of its run. Work is done on the top by the contact forces, per step "
+         "with the engine's own step (F . v_C h); the numerical remainder is the integrator's and the constraint "
+         "stabilization's; the elastic energy is what a soft contact stores at most (part of the normal work). n/a: the "
+         "simulator cannot give the term (counted as 0 in the remainder).",
+         "note");
+  DocTable t;
+  t.header = {"run", "E final - E0", "normal work", "friction work", "drilling work", "impacts (removed)",
+              "elastic max", "numerical (end)", "numerical max |N|"};
+  t.row_headers = true;
+  t.css = "detail";
+  auto row = [&](const std::string& name, const json& s) {
+    const double de = (num(s, "energy_final") - num(s, "energy_initial")) / scale_of(s);
+    t.rows.push_back({DocCell(name), DocCell(fmt(de, "%.3g")), DocCell(rel(s, "normal_work")),
+                      DocCell(rel(s, "friction_work")), DocCell(rel(s, "drilling_work")), DocCell(rel(s, "impact_energy")),
+                      DocCell(rel(s, "elastic_energy_max")), DocCell(rel(s, "numerical_energy_final")),
+                      DocCell(rel(s, "numerical_energy_max"))});
+  };
+  row("reference", ref);
+  for (const json& e : c.at("engines")) row(str(e, "engine"), e.at("summary"));
+  d.table(t);
+  std::vector<std::string> lines;
+  for (const json& e : c.at("engines"))
+    if (const std::string l = ledger_cause_sentence(c, e); !l.empty()) lines.push_back(str(e, "engine") + ": " + l);
+  if (!lines.empty()) d.list(lines);
+}
+
+}  // namespace tippe
