@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "cli/cli.h"
-#include "mujoco_import.h"
+#include "mujoco_api.h"
 #include "io/output_dir.h"
 #include "settings.h"
 #include "io/scene_io.h"
@@ -131,7 +131,7 @@ int import_mjcf(const ImportOptions& o) {
   refuse_output_over_inputs(o.out, {o.model});
   MjcfTopImport top;
   try {
-    top = import_mjcf_top(o.model, o.body, o.keyframe);
+    top = mujoco_api().import_top(o.model, o.body, o.keyframe);
   } catch (const MjcfImportError& e) {
     throw UsageError(e.what());
   }
