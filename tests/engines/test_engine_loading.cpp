@@ -62,6 +62,7 @@ TEST(EngineLoading, AnEngineRunMapsItsLibrary) {
 // runs only the reference, or prints the version, maps no engine library (and so pays none of their
 // relocations at start-up: BENCHMARKS.md, "Engines loaded on demand").
 TEST(EngineLoading, ReferenceRunAndVersionMapNoEngineLibrary) {
+  if (!tippe::engines_in_modules()) GTEST_SKIP() << "engines linked in (TIPPE_ENGINE_MODULES=OFF)";
   for (const auto& args : {run_args("analytic"), std::vector<std::string>{"--version"}}) {
     const std::string files = loaded_libraries(args);
     ASSERT_FALSE(files.empty()) << "LD_DEBUG=files reported nothing";
@@ -73,6 +74,7 @@ TEST(EngineLoading, ReferenceRunAndVersionMapNoEngineLibrary) {
 // A module that is not where the registry looks: the command says which engine, which file and
 // where it looked, and exits 2 (bad installation, not a bug); the reference still runs.
 TEST(EngineLoading, MissingModuleIsAClearErrorAndExit2) {
+  if (!tippe::engines_in_modules()) GTEST_SKIP() << "engines linked in (TIPPE_ENGINE_MODULES=OFF)";
   const fs::path dir = scratch();
   const fs::path empty = dir / "no-modules";
   fs::create_directories(empty);
