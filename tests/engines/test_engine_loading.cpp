@@ -96,6 +96,40 @@ TEST(EngineLoading, MissingModuleIsAClearErrorAndExit2) {
   EXPECT_EQ(e.code, 0);
 }
 
+// A module the loader refuses (not a shared object), and a shared object without the entry point:
+// the command names the module's path and the loader's reason, and exits 2.
+TEST(EngineLoading, UnloadableModuleNamesThePathAndTheLoadersReason) {
+  if (!tippe::engines_in_modules()) GTEST_SKIP() << "engines linked in (TIPPE_ENGINE_MODULES=OFF)";
+  const fs::path dir = scratch();
+  const fs::path bad = dir / "bad-modules";
+  fs::create_directories(bad);
+  const fs::path module = bad / "libtippe_engine_ode.so";
+  struct Case {
+    const char* what;
+    std::string want;
+  };
+  for (const Case& c : {Case{"text", "invalid ELF header"}, Case{"runtime", "has no entry point tippe_engine_ode"}}) {
+    SCOPED_TRACE(c.what);
+    fs::remove(module);
+    if (std::string(c.what) == "text") {
+      std::ofstream(module) << "not a shared object\n";
+    } else {
+      // A real shared object that is no engine's module: the bench's runtime itself.
+      fs::copy_file(fs::path(TIPPE_BINARY_DIR) / "lib" / "libtippe_runtime.so", module);
+    }
+    std::vector<std::string> argv = {"env", "TIPPE_ENGINE_PATH=" + bad.string(), std::string(TIPPE_BINARY_DIR) + "/tippe"};
+    const std::vector<std::string> args = run_args("ode");
+    argv.insert(argv.end(), args.begin(), args.end());
+    const ChildExit e = wait_process_within(spawn_process(argv, dir / "out.txt", dir / "err.txt"), 120);
+    EXPECT_EQ(e.code, 2);
+    std::ifstream in(dir / "err.txt");
+    std::stringstream err;
+    err << in.rdbuf();
+    EXPECT_NE(err.str().find(module.string()), std::string::npos) << err.str();
+    EXPECT_NE(err.str().find(c.want), std::string::npos) << err.str();
+  }
+}
+
 // The lines of this process's /proc/self/maps that name an engine's library.
 std::string mapped_engine_libraries() {
   std::ifstream maps("/proc/self/maps");
