@@ -36,6 +36,29 @@ install(TARGETS ${TIPPE_LIBRARY_TARGETS} EXPORT tippeTargets
 if(TARGET tippe)
   install(TARGETS tippe RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endif()
+# Engines as modules (TIPPE_ENGINE_MODULES): the shared runtime in lib/, each module in
+# lib/tippe/engines/ (where the registry looks, beside the runtime), and the programs that load
+# them find the runtime from their own place.
+if(TARGET tippe_runtime)
+  install(TARGETS tippe_runtime LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  get_property(_modules GLOBAL PROPERTY TIPPE_ENGINE_MODULE_TARGETS)
+  install(TARGETS ${_modules} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/tippe/engines)
+  file(RELATIVE_PATH _bin_to_lib /${CMAKE_INSTALL_BINDIR} /${CMAKE_INSTALL_LIBDIR})
+  if(TARGET tippe)
+    set_target_properties(tippe PROPERTIES INSTALL_RPATH "$ORIGIN/${_bin_to_lib}")
+  endif()
+  if(TARGET tippe_python)
+    file(RELATIVE_PATH _py_to_lib /${TIPPE_PYTHON_INSTALL_DIR} /${CMAKE_INSTALL_LIBDIR})
+    set_target_properties(tippe_python PROPERTIES INSTALL_RPATH "$ORIGIN/${_py_to_lib}")
+  endif()
+endif()
+# Whether the installed static tippe::engines holds the engines (TIPPE_ENGINE_MODULES=OFF) or the
+# reference alone: what the package's config and tippe.pc ask a consumer to find and link.
+if(TIPPE_ENGINES AND NOT TIPPE_ENGINE_MODULES)
+  set(TIPPE_STATIC_ENGINES ON)
+else()
+  set(TIPPE_STATIC_ENGINES OFF)
+endif()
 install(FILES ${PROJECT_SOURCE_DIR}/include/tippe/tippe.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tippe)
 file(GLOB TIPPE_ANALYTIC_HEADERS ${PROJECT_SOURCE_DIR}/analytic/*.h)
 install(FILES ${TIPPE_ANALYTIC_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tippe/analytic)
@@ -53,7 +76,7 @@ install(FILES ${PROJECT_BINARY_DIR}/tippeConfig.cmake ${PROJECT_BINARY_DIR}/tipp
         DESTINATION ${TIPPE_CMAKE_DIR})
 
 # pkg-config: the libraries are static, so their dependencies are listed for the link line too.
-if(TIPPE_ENGINES)
+if(TIPPE_STATIC_ENGINES)
   set(TIPPE_PC_REQUIRES "eigen3 tomlplusplus nlohmann_json bullet-float64 ode")
   # DART links as its imported target `dart` (libdart and its FCL); the .pc names them directly.
   # Simbody (engines/simbody/) likewise: its three libraries, no .pc of its own in Debian; and

@@ -158,3 +158,6 @@ const EngineInfo& bullet_engine_info() {
 }
 
 }  // namespace tippe
+
+// The module's one exported symbol, tippe_engine_bullet: the registry's way in (registry.h).
+TIPPE_ENGINE_ENTRY_POINT(bullet)

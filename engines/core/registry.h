@@ -1,8 +1,9 @@
-// The engine registry: one EngineInfo per simulator (name, role, factory, settings, version, colour).
+// The engine registry: one EngineInfo per simulator (name, role, factory, settings, version, colour), each engine's loaded from its module on first use.
 #pragma once
 
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -46,6 +47,9 @@ struct EngineInfo {
   std::string cost_knob;
   std::string version;   // library version, as Simulator::version() reports it
   std::string colour;    // plot colour (#rrggbb) in every report
+  // An engine's own interface beyond Simulator, for the one command that is about that engine
+  // (MuJoCo's MJCF export and import: engines/mujoco/mujoco_api.h says its type); nullptr for most.
+  const void* extension = nullptr;
 };
 
 // Builds the `validate` and `default_settings` members from a settings struct with `visit`.
@@ -77,18 +81,49 @@ EngineInfo engine_entry(std::string name, EngineRole role, std::function<std::un
   return e;
 }
 
-// Each simulator's entry, defined in its folder: the reference's and one per line of engine_list.h.
+// Each simulator's entry, defined in its folder: the reference's, linked into the registry, and
+// one per line of engine_list.h, which its module hands over through its entry point.
 const EngineInfo& analytic_engine_info();
 #define TIPPE_ENGINE(name) const EngineInfo& name##_engine_info();
 #include "engine_list.h"
 #undef TIPPE_ENGINE
 
-// Every registered simulator, the reference first, then the engines in registration order.
+// An engine's entry point, one line at the end of its NAME_sim.cpp: the only symbol its module
+// exports for the registry, `tippe_engine_NAME`, returns its entry. The same function is what a
+// build with the engines linked statically (TIPPE_ENGINE_MODULES=OFF) calls directly.
+#define TIPPE_ENGINE_ENTRY_POINT(name)                                                                        \
+  extern "C" __attribute__((visibility("default"))) const ::tippe::EngineInfo* tippe_engine_##name() { \
+    return &::tippe::name##_engine_info();                                                               \
+  }
+
+// An engine's module could not be loaded (not found, or dlopen/dlsym failed): the message names
+// the engine, the module and the paths tried or the loader's own error.
+class EngineLoadError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+  ~EngineLoadError() override;  // key function in registry.cpp: one typeinfo, in the shared runtime
+};
+
+// Where the registry looks for an engine's module, in order: the directories of the environment
+// variable TIPPE_ENGINE_PATH (':'-separated; for tests and relocated trees) when it is set and not
+// empty, otherwise DIR/tippe/engines where DIR holds the library the registry itself is in (the
+// build tree's lib/, or the installed lib/). Empty when the engines are linked in (no modules).
+std::vector<std::string> engine_module_dirs();
+// Whether this build loads its engines from modules (TIPPE_ENGINE_MODULES=ON) rather than linking them.
+bool engines_in_modules();
+// The file name of an engine's module (libtippe_engine_NAME.so).
+std::string engine_module_file(const std::string& name);
+
+// Every registered simulator, the reference first, then the engines in registration order. Loads
+// every engine's module: what needs only the names asks available_engines() or engine_names().
 const std::vector<EngineInfo>& engine_registry();
-// nullptr for an unknown name.
+// nullptr for an unknown name; an engine's module is loaded on its first request (EngineLoadError
+// when it cannot be).
 const EngineInfo* find_engine(const std::string& name);
-// Throws std::invalid_argument naming the known engines for an unknown name.
+// Throws std::invalid_argument naming the known engines for an unknown name (and loads as find_engine).
 const EngineInfo& engine_info(const std::string& name);
+// Whether an engine's module is loaded already (the reference always is); loads nothing.
+bool engine_loaded(const std::string& name);
 const EngineInfo& reference_engine();
 // The names with role Engine (the default engine list of compare and gates).
 std::vector<std::string> engine_names();

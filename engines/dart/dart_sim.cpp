@@ -320,3 +320,6 @@ const EngineInfo& dart_engine_info() {
 }
 
 }  // namespace tippe
+
+// The module's one exported symbol, tippe_engine_dart: the registry's way in (registry.h).
+TIPPE_ENGINE_ENTRY_POINT(dart)

@@ -17,6 +17,7 @@
 
 #include "adapters.h"
 #include "fixed_step.h"
+#include "mujoco_api.h"
 #include "mujoco_mjcf.h"
 #include "mujoco_settings.h"
 #include "mujoco_top.h"
@@ -482,6 +483,9 @@ const EngineInfo& mujoco_engine_info() {
                      {"cone", {"\"elliptic\"", "\"pyramidal\""}},
                      {"noslip_iterations", {"0", "10"}}};
     e.cost_knob = "timestep";
+    // `tippe export-mjcf` and `tippe import-mjcf` (mujoco_api.h).
+    static const MujocoApi api = {mujoco_mjcf, mujoco_mjcf_missing, import_mjcf_top, mjcf_scene_mismatches};
+    e.extension = &api;
     return e;
   }();
   return info;
@@ -518,3 +522,6 @@ std::vector<std::string> mujoco_mjcf_missing(const Scene& scene) {
 }
 
 }  // namespace tippe
+
+// The module's one exported symbol, tippe_engine_mujoco: the registry's way in (registry.h).
+TIPPE_ENGINE_ENTRY_POINT(mujoco)

@@ -465,3 +465,6 @@ const EngineInfo& ode_engine_info() {
 }
 
 }  // namespace tippe
+
+// The module's one exported symbol, tippe_engine_ode: the registry's way in (registry.h).
+TIPPE_ENGINE_ENTRY_POINT(ode)

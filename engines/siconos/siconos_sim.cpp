@@ -404,3 +404,6 @@ const EngineInfo& siconos_engine_info() {
 }
 
 }  // namespace tippe
+
+// The module's one exported symbol, tippe_engine_siconos: the registry's way in (registry.h).
+TIPPE_ENGINE_ENTRY_POINT(siconos)

@@ -419,3 +419,6 @@ const EngineInfo& simbody_engine_info() {
 }
 
 }  // namespace tippe
+
+// The module's one exported symbol, tippe_engine_simbody: the registry's way in (registry.h).
+TIPPE_ENGINE_ENTRY_POINT(simbody)

@@ -15,6 +15,7 @@
 #include "io/interrupt.h"
 #include "io/output_dir.h"
 #include "io/scene_io.h"
+#include "registry.h"
 
 namespace tippe::cli {
 
@@ -34,9 +35,10 @@ struct Command {
 using Setup = Command (*)(CLI::App& app);
 
 // A subcommand's exception as an exit code, its message on stderr when `print`: bad input
-// (SceneError, UsageError, InputError) and an unusable output path (OutputError) -> 2; a signal that ended
-// the command cleanly (Interrupted) -> 128 + its number, as a shell reports a signal; anything
-// else is a bug -> kInternalExit, said as "internal". 1 is a failing gate's alone, so that CI can
+// (SceneError, UsageError, InputError), an unusable output path (OutputError) and an engine module
+// that cannot be loaded (EngineLoadError) -> 2; a signal that ended the command cleanly
+// (Interrupted) -> 128 + its number, as a shell reports a signal; anything else is a bug ->
+// kInternalExit, said as "internal". 1 is a failing gate's alone, so that CI can
 // tell "the settings fail" from "tippe broke".
 inline constexpr int kInternalExit = 3;
 
@@ -57,6 +59,9 @@ inline int error_exit(const std::exception_ptr& e, bool print = true) {
     if (print) std::cerr << "tippe: error: " << x.what() << "\n";
     return 2;
   } catch (const OutputError& x) {
+    if (print) std::cerr << "tippe: error: " << x.what() << "\n";
+    return 2;
+  } catch (const EngineLoadError& x) {  // an engine's module missing or unloadable: the installation's fault, said as such
     if (print) std::cerr << "tippe: error: " << x.what() << "\n";
     return 2;
   } catch (const Interrupted& x) {

@@ -2,9 +2,9 @@
 #include <iostream>
 #include <memory>
 
-#include "adapters.h"
 #include "cli/cli.h"
 #include "io/output_dir.h"
+#include "mujoco_api.h"
 #include "records/records.h"
 #include "io/scene_io.h"
 
@@ -25,14 +25,14 @@ int export_mjcf(const ExportOptions& o) {
   if (!o.out.empty()) refuse_output_over_inputs(o.out, scene_input_files(scene));
   std::string text;
   try {
-    text = mujoco_mjcf(scene);
+    text = mujoco_api().mjcf(scene);
   } catch (const std::invalid_argument& e) {
     throw UsageError(scene.source_file + ": " + e.what());
   }
   if (text.empty()) throw std::runtime_error("mujoco_mjcf produced no model");
   // A model that lacks part of the scene's physics is refused, or written with its gaps said in
   // the file and on stderr (--force): a user opening it must not take it for the scene.
-  const std::vector<std::string> missing = mujoco_mjcf_missing(scene);
+  const std::vector<std::string> missing = mujoco_api().mjcf_missing(scene);
   if (!missing.empty() && !o.force) {
     std::string why;
     for (const auto& m : missing) why += (why.empty() ? "" : "; ") + m;

@@ -9,7 +9,6 @@
 
 #include "cli/cli.h"
 #include "library/verbs.h"
-#include "mujoco_import.h"
 #include "io/output_dir.h"
 #include "settings.h"
 #include "io/scene_io.h"

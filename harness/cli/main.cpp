@@ -21,11 +21,17 @@ int main(int argc, char** argv) {
   bool quiet = false;
   app.add_flag("-q,--quiet", quiet, "No progress on stderr (errors and warnings still go there)");
   app.fallthrough();
-  // Version, commit and the engine libraries this build links (from the engine registry).
+  // Version, commit, the reference's library and each engine's module (from the engine registry).
+  // An engine's library version is its module's to say, once loaded (every record carries it):
+  // --version loads none, so that it costs no engine library's start-up.
   app.set_version_flag("--version", [] {
     const BuildInfo b = build_info();
     std::string text = "tippe " + tippe::version() + " (commit " + b.git_commit + ", " + b.compiler + ")";
-    for (const EngineInfo& e : engine_registry()) text += "\n  " + e.name + ": " + e.version;
+    for (const std::string& name : available_engines()) {
+      text += "\n  " + name + ": ";
+      if (!engines_in_modules() || engine_loaded(name)) text += engine_info(name).version;
+      else text += "module " + engine_module_file(name) + ", loaded on first use";
+    }
     return text;
   });
   // Adding a subcommand: write cli_NAME.cpp with setup_NAME, declare it in cli.h, list it here.

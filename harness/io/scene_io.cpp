@@ -400,6 +400,10 @@ class Interpreter : public TomlReader {
         if (overridden("run." + k) && std::string(e.what()).rfind(table + k + ":", 0) == 0)
           hint = "; run." + k + " was set with --set: set " + table + k + " instead";
       throw SceneError(file() + ": " + e.what() + hint);
+    } catch (const EngineLoadError& e) {
+      // A table whose engine's module cannot be loaded cannot be checked: the scene is refused
+      // with the loader's reason (SceneError stays the only exception a scene's reading throws).
+      throw SceneError(file() + ": " + e.what());
     }
   }
 

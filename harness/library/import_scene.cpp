@@ -9,6 +9,7 @@
 #include "io/output_dir.h"
 #include "io/scene_io.h"
 #include "library/verbs.h"
+#include "mujoco_api.h"
 #include "settings.h"
 
 namespace tippe {
@@ -124,7 +125,7 @@ MjcfScene import_mjcf_scene(const MjcfSceneRequest& o) {
   }
   MjcfScene s;
   try {
-    s.top = import_mjcf_top(o.model, o.body, o.keyframe);
+    s.top = mujoco_api().import_top(o.model, o.body, o.keyframe);  // the MuJoCo module, loaded on first use
   } catch (const MjcfImportError& e) {
     throw InputError(e.what());
   }
