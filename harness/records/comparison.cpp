@@ -164,7 +164,8 @@ Metrics metrics_from_json(const json& j) {
   // The rule and the ledger are absent in records written before them.
   if (j.contains("energy_gain_rule")) {
     m.energy_gain_rule = j.at("energy_gain_rule").get<std::string>();
-    if (m.energy_gain_rule != "ledger" && m.energy_gain_rule != "total")
+    // Empty: what to_json writes for a record from before the rule (it counted the total).
+    if (!m.energy_gain_rule.empty() && m.energy_gain_rule != "ledger" && m.energy_gain_rule != "total")
       throw std::invalid_argument("metrics.energy_gain_rule: \"" + m.energy_gain_rule + "\" is not ledger or total");
   }
   const std::pair<const char*, std::optional<double>*> ledger[] = {{"normal_work", &m.normal_work},

@@ -30,6 +30,8 @@ const std::vector<GateMetric>& gate_metrics() {
       TIPPE_GATE_OPTIONAL(numerical_energy_final, "/ E0, numerical energy of the ledger at the end"),
       TIPPE_GATE_OPTIONAL(friction_work, "/ E0, work of the friction forces (|value| is compared)"),
       TIPPE_GATE_OPTIONAL(normal_work, "/ E0, work of the normal forces (|value| is compared)"),
+      TIPPE_GATE_OPTIONAL(drilling_work, "/ E0, work of the drilling torques (|value| is compared)"),
+      TIPPE_GATE_OPTIONAL(impact_energy, "/ E0, energy removed at impacts (|value| is compared)"),
       TIPPE_GATE_OPTIONAL(elastic_energy_max, "/ E0, largest elastic energy in the contact"),
       TIPPE_GATE_VALUE(contact_path_rms_error, "/ R"),
       TIPPE_GATE_VALUE(contact_path_max_error, "/ R"),

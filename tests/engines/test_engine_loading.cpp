@@ -22,8 +22,10 @@ namespace fs = std::filesystem;
 // One name part of each engine's own libraries (Bullet, ODE, MuJoCo, DART, Simbody, Siconos).
 const char* const kEngineLibraries[] = {"libBullet", "libode", "libmujoco", "libdart", "libSimTK", "libsiconos"};
 
+// One directory per test: CTest runs this program's tests at the same time, each in its own process.
 fs::path scratch() {
-  const fs::path dir = fs::path(::testing::TempDir()) / "tippe_engine_loading";
+  const fs::path dir = fs::path(::testing::TempDir()) /
+                       ("tippe_engine_loading_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
   fs::create_directories(dir);
   return dir;
 }

@@ -137,7 +137,7 @@ std::vector<Case> cases() {
        {": run.sample_interval: 1e-12 gives 2.5e+13 samples, up to "}},
       // 1e8 samples passed the old count guard: ~55 GB of CSV. The budget is bytes.
       {"samples_over_the_byte_budget", edit(b, "sample_interval = 0.01", "sample_interval = 2.5e-7"), {},
-       {": run.sample_interval: 2.5e-07 gives 100000001 samples, up to 82398 MiB of trajectory, over the budget of 1024 MiB"}},
+       {": run.sample_interval: 2.5e-07 gives 100000001 samples, up to 100709 MiB of trajectory, over the budget of 1024 MiB"}},
       {"engine_array_with_a_string", b + "[engines.mujoco]\nsolref = [0.002, \"x\"]\n", {},
        {": engines.mujoco.solref[1]: expected a number, got a string"}},
       {"coulomb_negative_mu", edit(coulomb, "mu = 0.3", "mu = -0.3"), {}, {": contact.mu: -0.3 is out of range (expected mu >= 0)"}},
