@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates every published page from one commit: the comparison reports, the sweeps, the extremes battery, the index, and the outputs BENCHMARKS.md's tables are copied from; refuses a working tree with changes, so every record and page names a commit that holds exactly the code that made it: scripts/publish-all.sh [BUILD_DIR] (default build-publish).
+# Regenerates every published page from one commit: the comparison reports, the sweeps, the extremes battery, the index, BENCHMARKS.md's result tables, and the outputs its speed tables are copied from; refuses a working tree with changes, so every record and page names a commit that holds exactly the code that made it: scripts/publish-all.sh [BUILD_DIR] (default build-publish).
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -21,12 +21,14 @@ echo "publish-all: publishing from commit $commit with $build" >&2
 
 bash scripts/publish-reports.sh "$build"
 bash scripts/publish-sweep.sh "$build"
-for sweep in modelling horizon boundaries; do
+for sweep in modelling horizon boundaries simbody siconos; do
   SWEEP="harness/sweeps/$sweep.toml" bash scripts/publish-sweep.sh "$build"
 done
 bash scripts/publish-extremes.sh "$build"
 # The index last: its sweep matrices read the sweeps just published.
 "$build/tippe" report reports --index >/dev/null
+# BENCHMARKS.md's result tables, copied from the pages just published (no table by hand).
+python3 scripts/benchmarks-tables.py
 
 # The outputs BENCHMARKS.md's speed tables are copied from, each headed by the commit (machine
 # dependent: they are not checked by CI, only regenerated here).

@@ -1,0 +1,162 @@
+#!/usr/bin/env python3
+"""Copies BENCHMARKS.md's generated tables from the published pages they summarise, so no table is written by hand.
+
+scripts/benchmarks-tables.py [--check] [--file BENCHMARKS.md]
+
+A generated block in BENCHMARKS.md is
+
+    <!-- generated from reports/PAGE.md, "HEADING" -->
+    ...
+    <!-- end generated -->
+
+and holds the first Markdown table under the heading HEADING of the published page (every line
+from the first line starting with "|" to the last of that run), with the page's relative links
+made relative to the repository root, and a line naming the commits the page's records came
+from. The page computed the table from its records (tippe report), so BENCHMARKS.md and the
+published pages give one answer. Without --check the blocks are rewritten in place (atomically);
+with --check nothing is written and the exit status is 1 when a block differs from its page
+(a table edited by hand, or a page republished without running this script). Exit 2 on bad input:
+a marker that names no published page or no heading.
+"""
+import argparse
+import glob
+import json
+import os
+import re
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BEGIN = re.compile(r'^<!-- generated from (reports/[A-Za-z0-9_.-]+(?:/[A-Za-z0-9_.-]+)*\.md), "([^"<>]+)" -->$')
+END = "<!-- end generated -->"
+LINK = re.compile(r"\]\(([^)#:\s][^):\s]*)\)")
+COMMIT = re.compile(r"^[0-9a-f]{7,40}$")
+
+
+class BadInput(Exception):
+    pass
+
+
+def page_table(page, heading, where):
+    if ".." in page.split("/"):
+        raise BadInput(f'{where}: "{page}": a published page is named without ".."')
+    path = os.path.join(ROOT, page)
+    try:
+        with open(path, encoding="utf-8") as f:
+            lines = f.read().split("\n")
+    except OSError as e:
+        raise BadInput(f"{where}: {page}: {e.strerror}")
+    try:
+        start = next(i for i, l in enumerate(lines) if re.match(r"^#+ ", l) and l.split(" ", 1)[1].strip() == heading)
+    except StopIteration:
+        raise BadInput(f'{where}: {page} has no heading "{heading}"')
+    table = []
+    for l in lines[start + 1:]:
+        if l.startswith("|"):
+            table.append(l)
+        elif table or re.match(r"^#+ ", l):
+            break
+    if not table:
+        raise BadInput(f'{where}: {page}: no table under "{heading}"')
+    base = os.path.dirname(page)
+    # Links on the page are relative to its directory; here they are relative to the root.
+    return [LINK.sub(lambda m: "](" + os.path.normpath(os.path.join(base, m.group(1))) + ")", l) for l in table]
+
+
+def page_commits(page):
+    """The commits the records behind a page name (its directory's records; the index's: every comparison's)."""
+    d = os.path.dirname(os.path.join(ROOT, page))
+    files = glob.glob(os.path.join(d, "*.json")) + glob.glob(os.path.join(d, "*.jsonl"))
+    if os.path.normpath(d) == os.path.join(ROOT, "reports"):
+        files += glob.glob(os.path.join(d, "*", "comparison.json"))
+    commits = set()
+    for name in files:
+        with open(name, encoding="utf-8") as f:
+            for line in f if name.endswith(".jsonl") else [f.read()]:
+                line = line.strip()
+                if not line:
+                    continue
+                try:
+                    commits.update(found_commits(json.loads(line)))
+                except json.JSONDecodeError as e:
+                    raise BadInput(f"{os.path.relpath(name, ROOT)}: not JSON: {e}")
+    return sorted(c[:12] for c in commits if COMMIT.match(c))
+
+
+def found_commits(j):
+    if isinstance(j, dict):
+        for k, v in j.items():
+            if k == "git_commit" and isinstance(v, str):
+                yield v
+            else:
+                yield from found_commits(v)
+    elif isinstance(j, list):
+        for v in j:
+            yield from found_commits(v)
+
+
+def render(text, name):
+    lines = text.split("\n")
+    out, i = [], 0
+    blocks = 0
+    while i < len(lines):
+        m = BEGIN.match(lines[i])
+        if lines[i].startswith("<!-- generated from") and not m:
+            raise BadInput(f'{name}:{i + 1}: a marker is <!-- generated from reports/PAGE.md, "HEADING" -->')
+        out.append(lines[i])
+        i += 1
+        if not m:
+            continue
+        try:
+            end = lines.index(END, i)
+        except ValueError:
+            raise BadInput(f"{name}:{i}: no {END} after this marker")
+        page, heading = m.group(1), m.group(2)
+        commits = page_commits(page)
+        out.append("")
+        out.extend(page_table(page, heading, f"{name}:{i}"))
+        out.append("")
+        out.append(f"Copied from [{page}]({page}) (\"{heading}\") by `scripts/benchmarks-tables.py`; "
+                   f"the records were made at commit{'s' if len(commits) != 1 else ''} {', '.join(commits) or 'none named'}.")
+        out.append("")
+        out.append(END)
+        i = end + 1
+        blocks += 1
+    return "\n".join(out), blocks
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--check", action="store_true", help="exit 1 when a block differs from its page; write nothing")
+    ap.add_argument("--file", default=os.path.join(ROOT, "BENCHMARKS.md"))
+    a = ap.parse_args()
+    name = os.path.relpath(a.file, ROOT)
+    try:
+        with open(a.file, encoding="utf-8") as f:
+            text = f.read()
+        new, blocks = render(text, name)
+    except (BadInput, OSError) as e:
+        print(f"benchmarks-tables: {e}", file=sys.stderr)
+        return 2
+    if a.check:
+        if new != text:
+            old_lines, new_lines = text.split("\n"), new.split("\n")
+            first = next((k for k, (x, y) in enumerate(zip(old_lines, new_lines)) if x != y), min(len(old_lines), len(new_lines)))
+            print(f"benchmarks-tables: {name}:{first + 1}: a generated table differs from its published page "
+                  f"(run scripts/benchmarks-tables.py); here: {old_lines[first] if first < len(old_lines) else '(end)'!r}; "
+                  f"the page gives: {new_lines[first] if first < len(new_lines) else '(end)'!r}", file=sys.stderr)
+            return 1
+        print(f"benchmarks-tables: {name}: {blocks} generated table(s) match their pages")
+        return 0
+    if new != text:
+        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(a.file), prefix=".benchmarks-tables.")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(new)
+        os.chmod(tmp, os.stat(a.file).st_mode & 0o777)
+        os.replace(tmp, a.file)
+    print(f"benchmarks-tables: {name}: {blocks} generated table(s) written")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

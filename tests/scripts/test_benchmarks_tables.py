@@ -1,0 +1,67 @@
+#!/usr/bin/env python3
+"""Tests scripts/benchmarks-tables.py: BENCHMARKS.md's generated tables match the published pages, a table edited by hand is caught, bad markers are refused."""
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+root = sys.argv[1]
+script = os.path.join(root, "scripts", "benchmarks-tables.py")
+failures = []
+
+
+def run(*args):
+    return subprocess.run([sys.executable, script, *args], capture_output=True, text=True)
+
+
+def expect(name, ok, detail=""):
+    print(("ok   " if ok else "FAIL ") + name + (": " + detail if detail and not ok else ""))
+    if not ok:
+        failures.append(name)
+
+
+# 1. The committed BENCHMARKS.md: every generated block equals its page's table.
+r = run("--check")
+expect("committed tables match their pages", r.returncode == 0, r.stderr.strip())
+blocks = int(re.search(r"(\d+) generated table", r.stdout).group(1)) if r.returncode == 0 else 0
+expect("BENCHMARKS.md has generated tables", blocks >= 2, f"{blocks} found")
+
+with open(os.path.join(root, "BENCHMARKS.md"), encoding="utf-8") as f:
+    text = f.read()
+with tempfile.TemporaryDirectory() as d:
+    copy = os.path.join(d, "BENCHMARKS.md")
+
+    def check_with(t):
+        with open(copy, "w", encoding="utf-8") as f:
+            f.write(t)
+        return run("--check", "--file", copy)
+
+    # 2. One cell of a generated table edited by hand: --check fails and names the line.
+    begin = text.index("<!-- generated from")
+    row = text.index("\n|", begin) + 1            # the table's first line
+    row = text.index("\n|", text.index("\n|", row) + 1) + 1  # its first data row (past the separator)
+    cell_end = text.index("|", row + 1)
+    edited = text[:row + 1] + " hand-edited " + text[cell_end:]
+    r = check_with(edited)
+    line = edited[:row].count("\n") + 1
+    expect("a hand-edited cell fails the check", r.returncode == 1 and f":{line}:" in r.stderr, r.stderr.strip())
+    # ... and the rewrite restores the page's table.
+    r2 = run("--file", copy)
+    with open(copy, encoding="utf-8") as f:
+        expect("rewriting restores the table", r2.returncode == 0 and f.read() == text)
+
+    # 3. Bad input: exit 2 with the file and the reason, nothing written.
+    for name, marker, reason in [
+        ("a page outside reports/", '<!-- generated from README.md, "x" -->', "a marker is"),
+        ("a missing page", '<!-- generated from reports/nope/report.md, "x" -->', "No such file"),
+        ("a heading the page lacks", '<!-- generated from reports/README.md, "No such heading" -->', 'has no heading'),
+        ("\"..\" in the page", '<!-- generated from reports/../README.md, "x" -->', 'without ".."'),
+    ]:
+        bad = text + "\n" + marker + "\n<!-- end generated -->\n"
+        r = check_with(bad)
+        expect("refuses " + name, r.returncode == 2 and "BENCHMARKS.md" in r.stderr and reason in r.stderr, r.stderr.strip())
+    r = check_with(text + '\n<!-- generated from reports/README.md, "Tippe top: engines against the analytic reference" -->\n')
+    expect("refuses a block without its end", r.returncode == 2 and "no <!-- end generated -->" in r.stderr, r.stderr.strip())
+
+sys.exit(1 if failures else 0)
