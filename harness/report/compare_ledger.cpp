@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "report/ledger_chart.h"
 #include "report/report_text.h"
 
 namespace tippe {
@@ -117,7 +118,7 @@ std::string ledger_cause_sentence(const json& c, const json& e) {
   return out + ".";
 }
 
-void add_energy_ledger(Document& d, const json& c) {
+void add_energy_ledger(Document& d, const json& c, bool chart) {
   const json& ref = c.at("reference").at("summary");
   bool any = has_ledger(ref);
   for (const json& e : c.at("engines")) any = any || has_ledger(e.at("summary"));
@@ -144,6 +145,9 @@ void add_energy_ledger(Document& d, const json& c) {
   row("reference", ref);
   for (const json& e : c.at("engines")) row(str(e, "engine"), e.at("summary"));
   d.table(t);
+  if (chart)
+    d.figure(kLedgerChartFile, "The same accounts as bars: each run's terms / |E0| stacked from 0 (losses left, gains "
+                               "right); the black tick is E_final - E0, where the terms must end.");
   std::vector<std::string> lines;
   for (const json& e : c.at("engines"))
     if (const std::string l = ledger_cause_sentence(c, e); !l.empty()) lines.push_back(str(e, "engine") + ": " + l);

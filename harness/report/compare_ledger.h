@@ -13,8 +13,9 @@ namespace tippe {
 // its account (normal, friction and drilling work, impacts, the contact's elastic energy, the
 // numerical remainder), each / |E0| of its run, "n/a" for a term the simulator cannot give;
 // then one sentence per engine saying where its energy loss went. Nothing when no run carries
-// the ledger (records older than it).
-void add_energy_ledger(Document& d, const nlohmann::json& comparison);
+// the ledger (records older than it). `chart`: the page has the ledger chart (kLedgerChartFile,
+// report/ledger_chart.h) beside it, shown under the table.
+void add_energy_ledger(Document& d, const nlohmann::json& comparison, bool chart = false);
 
 // "by t = 2.13 its energy fell by 0.2 E0 (...); of that change 31 % numerical, 0 % friction work,
 // ...; the dominant term: numerical" for one engine entry of a comparison record (without the

@@ -14,6 +14,7 @@
 #include "records/records.h"
 #include "report/compare_events.h"
 #include "report/compare_ledger.h"
+#include "report/ledger_chart.h"
 #include "report/report_text.h"
 
 namespace tippe {
@@ -424,7 +425,8 @@ Document comparison_document(const json& c, const std::vector<std::string>& plot
          "note");
   d.table(doc_table(detail_table(c), "detail"), "More metrics", true);
   add_event_sequences(d, c);
-  add_energy_ledger(d, c);
+  const bool ledger_chart = std::find(plot_files.begin(), plot_files.end(), kLedgerChartFile) != plot_files.end();
+  add_energy_ledger(d, c, ledger_chart);
 
   d.heading(2, "Findings");
   const auto findings = report_findings(c);
@@ -432,7 +434,8 @@ Document comparison_document(const json& c, const std::vector<std::string>& plot
   else d.list(findings);
 
   d.heading(2, "Plots");
-  for (const auto& f : plot_files) d.figure(f, plot_caption(f));
+  for (const auto& f : plot_files)
+    if (f != kLedgerChartFile) d.figure(f, plot_caption(f));  // the ledger chart is in its section
   if (!plots_note.empty()) d.para(plots_note, "note");
 
   d.heading(2, "Scene");
@@ -499,6 +502,15 @@ void write_report(const std::string& out_dir, const json& comparison, bool plots
       if (fs::exists(dir / f, ec) && fs::file_size(dir / f, ec) > 0) p.files.push_back(f);
     if (!p.files.empty()) p.note += "; the plots shown are kept from an earlier run";
   }
+  // The ledger chart needs the record only (no trajectory, no gnuplot): drawn whenever plots are,
+  // kept from an earlier run like them when they are not.
+  const fs::path chart = dir / kLedgerChartFile;
+  if (plots) {
+    const std::string svg = ledger_chart_svg(comparison);
+    if (svg.empty()) fs::remove(chart, ec);
+    else write_file_atomic(chart.string(), svg);
+  }
+  if (fs::exists(chart, ec) && fs::file_size(chart, ec) > 0) p.files.push_back(kLedgerChartFile);
   // The trajectories, when they are here (published reports do not keep them).
   std::vector<std::string> data;
   std::vector<std::string> names = {"reference"};
