@@ -46,10 +46,12 @@ def page_table(page, heading, where):
             lines = f.read().split("\n")
     except OSError as e:
         raise BadInput(f"{where}: {page}: {e.strerror}")
-    try:
-        start = next(i for i, l in enumerate(lines) if re.match(r"^#+ ", l) and l.split(" ", 1)[1].strip() == heading)
-    except StopIteration:
+    found = [i for i, l in enumerate(lines) if re.match(r"^#+ ", l) and l.split(" ", 1)[1].strip() == heading]
+    if not found:
         raise BadInput(f'{where}: {page} has no heading "{heading}"')
+    if len(found) > 1:
+        raise BadInput(f'{where}: {page} has {len(found)} headings "{heading}": name one that is unique')
+    start = found[0]
     table = []
     for l in lines[start + 1:]:
         if l.startswith("|"):

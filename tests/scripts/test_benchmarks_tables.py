@@ -57,6 +57,7 @@ with tempfile.TemporaryDirectory() as d:
         ("a missing page", '<!-- generated from reports/nope/report.md, "x" -->', "No such file"),
         ("a heading the page lacks", '<!-- generated from reports/README.md, "No such heading" -->', 'has no heading'),
         ("\"..\" in the page", '<!-- generated from reports/../README.md, "x" -->', 'without ".."'),
+        ("a heading the page has twice", '<!-- generated from reports/sweep-default/report.md, "Charts" -->', 'name one that is unique'),
     ]:
         bad = text + "\n" + marker + "\n<!-- end generated -->\n"
         r = check_with(bad)
