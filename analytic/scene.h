@@ -78,6 +78,12 @@ struct RunSpec {
   // The harness runs a second, independent reference over the same scene and says from which
   // time on the two part (the reference's self-check, harness/measure/self_check.h); false skips it.
   bool self_check = true;
+  // How the bench counts an energy rise in a dissipative scene (harness/measure/metrics.h,
+  // docs/energy-ledger.md): "total" (the rise of E itself: the default, kDefaultEnergyGainRule) or
+  // "ledger" (the energy the run's ledger says was created, not released from a contact's store).
+  // A choice of the bench, not physics: it moves no run, only the class and the gain metrics, and
+  // is named beside them (energy_gain_rule in every comparison and sweep record).
+  std::string energy_gain_rule = "total";
   // Which of rtol, atol, method, self_check the scene file gave in [run], their older spelling
   // (they are the reference's settings, [engines.analytic]); the reference notes them.
   std::vector<std::string> alias_keys{};

@@ -333,7 +333,7 @@ class Interpreter : public TomlReader {
   }
 
   void read_run(const toml::table& t, RunSpec& r) const {
-    keys(t, "run", {"duration", "sample_interval", "rtol", "atol", "method", "self_check"});
+    keys(t, "run", {"duration", "sample_interval", "rtol", "atol", "method", "self_check", "energy_gain_rule"});
     r.duration = need_positive(t, "run", "duration");
     r.sample_interval = need_number(t, "run", "sample_interval");
     if (!(r.sample_interval > 0 && r.sample_interval <= r.duration))
@@ -359,6 +359,13 @@ class Interpreter : public TomlReader {
         fail("run.method", "must be \"bulirsch_stoer\", \"dopri5\" or \"rosenbrock4\", got \"" + r.method + "\"");
     }
     r.self_check = opt_bool(t, "run", "self_check").value_or(true);
+    if (const toml::node* m = t.get("energy_gain_rule")) {
+      const auto* str = m->as_string();
+      if (!str) fail("run.energy_gain_rule", "expected a string, got " + toml_value_text(*m));
+      r.energy_gain_rule = str->get();
+      if (r.energy_gain_rule != "total" && r.energy_gain_rule != "ledger")
+        fail("run.energy_gain_rule", "must be \"total\" or \"ledger\", got \"" + r.energy_gain_rule + "\"");
+    }
     for (const char* k : {"rtol", "atol", "method", "self_check"})
       if (t.contains(k)) r.alias_keys.push_back(k);
   }

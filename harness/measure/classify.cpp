@@ -57,17 +57,18 @@ std::optional<Finding> first_divergence(const Trajectory& tr) {
 
 std::optional<Finding> first_energy_gain(const Scene& scene, const Trajectory& tr) {
   // The rule of metrics.h (energy_gains): the same measurement as energy_gain_events.
-  const EnergyGains g = energy_gains(tr, contact_energy_allowance(scene), kDefaultEnergyGainRule);
+  const EnergyGainRule rule = energy_gain_rule(scene);
+  const EnergyGains g = energy_gains(tr, contact_energy_allowance(scene), rule);
   if (!g.events) return std::nullopt;
   const bool relative = tr.energy[0] != 0;
-  const bool ledger = kDefaultEnergyGainRule == EnergyGainRule::Ledger && !tr.numerical_energy.empty() &&
+  const bool ledger = rule == EnergyGainRule::Ledger && !tr.numerical_energy.empty() &&
                       std::isfinite(tr.numerical_energy.back());
   return Finding{g.time, std::string(ledger ? "energy created (by the ledger: not friction work, not released from the contact's store) rose by "
                                             : "energy rose by ") +
                              num(g.rise_at_first) + (relative ? " E0" : "") + " between t = " + num(g.since) +
                              " (its lowest so far) and " + num(g.time) + " in a dissipative scene (tolerance " +
                              num(g.tolerance) + " E0 on the net rise: 1e-06 E0 and the energy of 1e-4 R of contact depth; energy_gain_rule = " +
-                             to_string(kDefaultEnergyGainRule) + ")"};
+                             to_string(rule) + ")"};
 }
 
 std::optional<double> record_drift(const RunRecord& run, int surface) {

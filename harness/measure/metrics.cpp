@@ -104,6 +104,10 @@ double contact_energy_allowance(const Scene& scene) {
 
 const char* to_string(EnergyGainRule r) { return r == EnergyGainRule::Ledger ? "ledger" : "total"; }
 
+EnergyGainRule energy_gain_rule(const Scene& scene) {
+  return scene.run.energy_gain_rule == "ledger" ? EnergyGainRule::Ledger : EnergyGainRule::Total;
+}
+
 std::vector<double> energy_counted(const Trajectory& tr, EnergyGainRule rule) {
   if (rule == EnergyGainRule::Total || tr.numerical_energy.size() != tr.size()) return tr.energy;
   std::vector<double> c(tr.size());
@@ -245,9 +249,9 @@ Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, con
   if (engine_traj.size()) {
     const double E0 = engine_traj.energy.front();
     m.energy_final_ratio = engine_traj.energy.back() / E0;
-    m.energy_gain_rule = to_string(kDefaultEnergyGainRule);
+    m.energy_gain_rule = to_string(energy_gain_rule(scene));
     if (energy_must_not_rise(scene)) {
-      const EnergyGains g = energy_gains(engine_traj, contact_energy_allowance(scene), kDefaultEnergyGainRule);
+      const EnergyGains g = energy_gains(engine_traj, contact_energy_allowance(scene), energy_gain_rule(scene));
       m.energy_gain_events = g.events;
       m.energy_max_gain = g.events ? g.max_rise : 0.0;
     }

@@ -81,6 +81,9 @@ struct EnergyGains {
 enum class EnergyGainRule { Ledger, Total };
 const char* to_string(EnergyGainRule r);
 inline constexpr EnergyGainRule kDefaultEnergyGainRule = EnergyGainRule::Total;
+// The rule a scene asks for (run.energy_gain_rule, validated when the scene was read; its default
+// "total" is kDefaultEnergyGainRule).
+EnergyGainRule energy_gain_rule(const Scene& scene);
 // The series the rule is applied to, one value per sample (E0 + C(t) under Ledger, E under Total).
 std::vector<double> energy_counted(const Trajectory& trajectory, EnergyGainRule rule);
 

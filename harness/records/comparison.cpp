@@ -211,7 +211,11 @@ std::string physics_hash(const json& scene_json) {
   json physics = scene_json;
   for (const char* key : {"engines", "name", "description", "source_file", "content_hash", "notes"}) physics.erase(key);
   // Whether the reference is checked is not physics: the same reference serves both.
-  if (physics.contains("run") && physics["run"].is_object()) physics["run"].erase("self_check");
+  // Nor how the bench counts an energy gain: it moves no run, only the class.
+  if (physics.contains("run") && physics["run"].is_object()) {
+    physics["run"].erase("self_check");
+    physics["run"].erase("energy_gain_rule");
+  }
   // The drilling law at its default is left out: records made before the key existed describe
   // the same physics and keep their hash.
   if (physics.contains("contact") && physics["contact"].is_object() &&

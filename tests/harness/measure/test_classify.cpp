@@ -195,6 +195,26 @@ TEST(Classify, LedgerRuleCountsEnergyTheLedgerCannotExplain) {
       << c.reason;
 }
 
+TEST(Classify, TheScenesRunTableChoosesTheRule) {
+  // run.energy_gain_rule picks the rule the class counts with: the store's release is a gain
+  // under "total" (the default, kDefaultEnergyGainRule) and not under "ledger"; the reason names
+  // the rule that counted it.
+  const Trajectory tr = ledger_trajectory(true, 1.0);
+  Scene total = viscous_scene();
+  EXPECT_EQ(total.run.energy_gain_rule, to_string(kDefaultEnergyGainRule)) << "the scene's default is the constant";
+  const RunClass c = classify_run(total, ok_run(), nullptr, tr);
+  EXPECT_EQ(c.kind, RunClassKind::Unphysical);
+  EXPECT_NE(c.reason.find("energy_gain_rule = total"), std::string::npos) << c.reason;
+  Scene ledger = viscous_scene();
+  ledger.run.energy_gain_rule = "ledger";
+  EXPECT_EQ(energy_gain_rule(ledger), EnergyGainRule::Ledger);
+  expect_ok(classify_run(ledger, ok_run(), nullptr, tr));
+  // Energy the ledger cannot explain is a gain under both, named as the ledger's.
+  const RunClass created = classify_run(ledger, ok_run(), nullptr, ledger_trajectory(true, 0.0));
+  EXPECT_EQ(created.kind, RunClassKind::Unphysical);
+  EXPECT_NE(created.reason.find("energy_gain_rule = ledger"), std::string::npos) << created.reason;
+}
+
 TEST(Classify, LedgerRuleWithoutTheElasticEnergyCountsNormalWorkAsExchange) {
   // Where the engine's contact law gives no elastic energy (n/a), the normal force's work is
   // counted as an exchange with the contact's store: the rise it explains is not a gain.

@@ -337,7 +337,10 @@ TEST(Metrics, PhysicsHashIgnoresNamesAndEngineSettings) {
   b.source_file = "elsewhere.toml";
   b.content_hash = "ffffffffffffffff";
   b.engines["ode"]["timestep"] = 1e-5;
+  b.run.energy_gain_rule = "ledger";  // how a gain is counted moves no run: the cached reference serves both
   EXPECT_EQ(physics_hash(b), h);
+  EXPECT_EQ(scene_to_json(b).at("run").at("energy_gain_rule"), "ledger") << "named in the record when not the default";
+  EXPECT_FALSE(scene_to_json(a).at("run").contains("energy_gain_rule")) << "the default keeps every record as it was";
   b.contact.k = 1.5;
   EXPECT_NE(physics_hash(b), h);
   Scene c = a;
