@@ -9,7 +9,8 @@ A generated block in BENCHMARKS.md is
     ...
     <!-- end generated -->
 
-and holds the first Markdown table under the heading HEADING of the published page (every line
+and holds the first Markdown table under the heading HEADING of the published page ("SECTION >
+HEADING" for a heading the page repeats in each of its sections) (every line
 from the first line starting with "|" to the last of that run), with the page's relative links
 made relative to the repository root, and a line naming the commits the page's records came
 from. The page computed the table from its records (tippe report), so BENCHMARKS.md and the
@@ -27,7 +28,7 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BEGIN = re.compile(r'^<!-- generated from (reports/[A-Za-z0-9_.-]+(?:/[A-Za-z0-9_.-]+)*\.md), "([^"<>]+)" -->$')
+BEGIN = re.compile(r'^<!-- generated from (reports/[A-Za-z0-9_.-]+(?:/[A-Za-z0-9_.-]+)*\.md), "([^"]+)" -->$')
 END = "<!-- end generated -->"
 LINK = re.compile(r"\]\(([^)#:\s][^):\s]*)\)")
 COMMIT = re.compile(r"^[0-9a-f]{7,40}$")
@@ -46,12 +47,28 @@ def page_table(page, heading, where):
             lines = f.read().split("\n")
     except OSError as e:
         raise BadInput(f"{where}: {page}: {e.strerror}")
-    found = [i for i, l in enumerate(lines) if re.match(r"^#+ ", l) and l.split(" ", 1)[1].strip() == heading]
-    if not found:
-        raise BadInput(f'{where}: {page} has no heading "{heading}"')
-    if len(found) > 1:
-        raise BadInput(f'{where}: {page} has {len(found)} headings "{heading}": name one that is unique')
-    start = found[0]
+    # "A > B": the heading B within the section of heading A (a page repeats B under each scene).
+    start = 0
+    for part in [p.strip() for p in heading.split(" > ")]:
+        level = None
+        if start:
+            level = len(lines[start - 1]) - len(lines[start - 1].lstrip("#"))
+        found = []
+        for i in range(start, len(lines)):
+            m = re.match(r"^(#+) (.*)$", lines[i])
+            if not m:
+                continue
+            if level is not None and len(m.group(1)) <= level:
+                break  # the end of the enclosing section
+            if m.group(2).strip() == part:
+                found.append(i)
+        if not found:
+            raise BadInput(f'{where}: {page} has no heading "{part}"' + ("" if part == heading else f' (in "{heading}")'))
+        if len(found) > 1:
+            raise BadInput(f'{where}: {page} has {len(found)} headings "{part}": name one that is unique '
+                           f'(or its section first: "SECTION > {part}")')
+        start = found[0] + 1
+    start -= 1
     table = []
     for l in lines[start + 1:]:
         if l.startswith("|"):

@@ -62,6 +62,18 @@ with tempfile.TemporaryDirectory() as d:
         bad = text + "\n" + marker + "\n<!-- end generated -->\n"
         r = check_with(bad)
         expect("refuses " + name, r.returncode == 2 and "BENCHMARKS.md" in r.stderr and reason in r.stderr, r.stderr.strip())
+    # A heading the page repeats, named within its section: the table of that section.
+    r = check_with(text + '\n<!-- generated from reports/sweep-default/report.md, "Scene toy_viscous > Regime: does it still invert?" -->\n<!-- end generated -->\n')
+    expect("a repeated heading within its section", r.returncode == 1, r.stderr.strip())
+    run("--file", copy)
+    with open(copy, encoding="utf-8") as f:
+        got = f.read()
+    with open(os.path.join(root, "reports", "sweep-default", "report.md"), encoding="utf-8") as f:
+        page = f.read()
+    section = page[page.index("## Scene toy_viscous"):]
+    section = section[section.index("### Regime: does it still invert?"):]
+    first_row = next(l for l in section.split("\n") if l.startswith("| "))
+    expect("... copies that section's table", first_row in got and got.count("<!-- generated from") == blocks + 1)
     r = check_with(text + '\n<!-- generated from reports/README.md, "Tippe top: engines against the analytic reference" -->\n')
     expect("refuses a block without its end", r.returncode == 2 and "no <!-- end generated -->" in r.stderr, r.stderr.strip())
 
