@@ -117,6 +117,21 @@ struct ReferenceModel::Impl {
   EnergyLedger ledger_obs;  // the same at the observed time, when ledger_obs_valid
   bool ledger_obs_valid = true;
   double ledger_t = 0.0;
+  // The contact power over the last booked interval [a, b] (b = ledger_t), at a, at the five
+  // Gauss nodes the booking evaluated and at b (the end's check point or event): a sample inside
+  // the interval takes the work from its time to b from their interpolant, with no contact solve
+  // of its own, where that agrees with the interpolant without a's value to fit_tolerance;
+  // otherwise the quadrature of [t, b], as every sample did before (ReferenceModel::energy_ledger).
+  struct PowerFit {
+    bool valid = false;
+    double a = 0.0, b = 0.0;
+    std::array<Vec3, 7> p{};  // at a, at the Gauss nodes of [a, b], at b
+    // The work from t in [a, b] to b of the interpolated power: through all seven values
+    // (`with_start`) or through the last six.
+    Vec3 work_to_end(double t, bool with_start) const;
+  } power_fit;
+  Vec3 p_start = Vec3::Zero();  // the contact power at the stepper's current time
+  double fit_tolerance = 0.0;   // in energy, set at the start: see kFitTolerance
   double graze_lo = std::numeric_limits<double>::infinity(), graze_hi = -std::numeric_limits<double>::infinity();
   bool singular = false;  // a check point met a contact system without a unique solution
 
@@ -157,7 +172,8 @@ struct ReferenceModel::Impl {
   void track_graze(const GrazeNote& n);
   double graze_violation = 0.0;
 
-  std::vector<double> g_all(const StateVector& y);
+  // The event functions at y; `power`: the contact power there too, from the same forces.
+  std::vector<double> g_all(const StateVector& y, Vec3* power = nullptr);
 
   StateVector state_at(double t);
 
@@ -166,9 +182,11 @@ struct ReferenceModel::Impl {
   ContactForces forces_at_noted(const StateVector& y);
 
   Vec3 contact_power(const StateVector& y);
+  Vec3 contact_power(const StateVector& y, const ContactForces& f) const;
 
-  Vec3 gauss5(double a, double b);
-  Vec3 friction_work(double a, double b);
+  // `nodes`: where given, the power at the five Gauss nodes (zero where no contact is held).
+  Vec3 gauss5(double a, double b, std::array<Vec3, 5>* nodes = nullptr);
+  Vec3 friction_work(double a, double b, std::array<Vec3, 5>* nodes = nullptr);
   void accumulate_friction_work(double a, double b);
 
   double gap_acceleration(const StateVector& y, const ContactMode& m, int k);
