@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <system_error>
 
 namespace tippe {
@@ -27,8 +28,10 @@ inline const long double* powers_of_ten() {
 // rounded value (a ~ N 10^(X-16), 10^16 <= N < 10^17); false where the fast path cannot vouch
 // for the rounding (see g17).
 inline bool digits17(double a, std::uint64_t& n, int& x) {
-  int e2 = 0;
-  std::frexp(a, &e2);  // a = f 2^e2, 0.5 <= f < 1
+  // a = f 2^e2 with 0.5 <= f < 1, from the biased exponent (a is normal: subnormals have k > 27).
+  std::uint64_t bits;
+  std::memcpy(&bits, &a, sizeof bits);
+  const int e2 = static_cast<int>((bits >> 52) & 0x7ff) - 1022;
   x = static_cast<int>(std::floor((e2 - 1) * 0.30102999566398120));  // floor(log10(a)), or one below
   for (int pass = 0; pass < 2; ++pass) {
     const int k = 16 - x;
@@ -70,8 +73,22 @@ inline char* g17(char* p, char* end, double v) {
   int x = 0;
   if (!(std::isfinite(v) && a != 0.0 && g17_detail::digits17(a, n, x)))
     return std::to_chars(p, end, v, std::chars_format::general, 17).ptr;
+  // The digits two at a time from 32-bit halves (9 and 8 digits).
+  static constexpr char kPairs[] =
+      "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+      "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+      "8081828384858687888990919293949596979899";
   char d[17];
-  for (int i = 16; i >= 0; --i, n /= 10) d[i] = static_cast<char>('0' + n % 10);
+  std::uint32_t lo = static_cast<std::uint32_t>(n % 100000000U), hi = static_cast<std::uint32_t>(n / 100000000U);
+  for (int i = 15; i >= 9; i -= 2, lo /= 100) {
+    d[i] = kPairs[2 * (lo % 100)];
+    d[i + 1] = kPairs[2 * (lo % 100) + 1];
+  }
+  for (int i = 7; i >= 1; i -= 2, hi /= 100) {
+    d[i] = kPairs[2 * (hi % 100)];
+    d[i + 1] = kPairs[2 * (hi % 100) + 1];
+  }
+  d[0] = static_cast<char>('0' + hi);
   int last = 16;  // the last digit kept: %g drops trailing zeros
   while (last > 0 && d[last] == '0') --last;
   if (std::signbit(v)) *p++ = '-';
