@@ -65,13 +65,18 @@ inline bool digits17(double a, std::uint64_t& n, int& x) {
 // same bytes: "%.17g" in the C locale) and returns the end of what it wrote; end - p must be
 // at least 32. The trajectory writes 33 numbers per sample this way: libstdc++'s to_chars at a
 // given precision takes ~600 instructions a number; this path takes about a tenth of that for
-// numbers between 1e-11 and 1e43 and hands the rest, zeros, infinities and NaNs (and the few
+// numbers between 1e-11 and 1e43 and zeros, and hands the rest, infinities and NaNs (and the few
 // numbers whose 18th digit is close to a tie) to to_chars.
 inline char* g17(char* p, char* end, double v) {
+  if (v == 0.0) {  // "0" or "-0"
+    if (std::signbit(v)) *p++ = '-';
+    *p++ = '0';
+    return p;
+  }
   const double a = std::fabs(v);
   std::uint64_t n = 0;
   int x = 0;
-  if (!(std::isfinite(v) && a != 0.0 && g17_detail::digits17(a, n, x)))
+  if (!(std::isfinite(v) && g17_detail::digits17(a, n, x)))
     return std::to_chars(p, end, v, std::chars_format::general, 17).ptr;
   // The digits two at a time from 32-bit halves (9 and 8 digits).
   static constexpr char kPairs[] =
