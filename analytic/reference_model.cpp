@@ -174,6 +174,44 @@ Vec3 ReferenceModel::Impl::PowerFit::work_to_end(double t, bool with_start) cons
   return half * (with_start ? all.work_to_end(x, p.data()) : no_start.work_to_end(x, p.data() + 1));
 }
 
+bool ReferenceModel::Impl::PowerFit::trusted_work_to_end(double t, double tolerance, Vec3& work) const {
+  work = work_to_end(t, true);
+  return (work - work_to_end(t, false)).cwiseAbs().maxCoeff() <= tolerance;
+}
+
+void ReferenceModel::Impl::refine_power_fit() {
+  const PowerFit& f = power_fit;
+  const double mid = 0.5 * (f.a + f.b);  // the whole interval's middle Gauss node (x = 0)
+  const double ends[3] = {f.a, mid, f.b};
+  const Vec3 at[3] = {f.p[0], f.p[3], f.p[6]};
+  for (int h = 0; h < 2; ++h) {
+    PowerFit& half = power_halves[h];
+    std::array<Vec3, 5> nodes;
+    (void)friction_work(ends[h], ends[h + 1], &nodes);
+    half.valid = true;
+    half.a = ends[h];
+    half.b = ends[h + 1];
+    half.p[0] = at[h];
+    std::copy(nodes.begin(), nodes.end(), half.p.begin() + 1);
+    half.p[6] = at[h + 1];
+  }
+}
+
+bool ReferenceModel::Impl::fitted_work_to_end(double t, Vec3& work) {
+  if (power_fit.trusted_work_to_end(t, fit_tolerance, work)) return true;
+  if (!power_halves[0].valid) {
+    if (fit_misses++ == 0) return false;
+    refine_power_fit();
+  }
+  const PowerFit& late = power_halves[1];
+  if (t >= late.a) return late.trusted_work_to_end(t, fit_tolerance, work);
+  Vec3 rest;
+  if (!late.trusted_work_to_end(late.a, fit_tolerance, rest)) return false;
+  if (!power_halves[0].trusted_work_to_end(t, fit_tolerance, work)) return false;
+  work += rest;
+  return true;
+}
+
 void EnergyLedger::add_contact_work(const Vec3& against) {
   friction += against.sum();
   normal += against.x();
@@ -189,6 +227,8 @@ void ReferenceModel::Impl::accumulate_friction_work(double a, double b) {
   power_fit.valid = false;
   power_fit.a = a;
   power_fit.b = b;
+  power_halves[0].valid = power_halves[1].valid = false;
+  fit_misses = 0;
   power_fit.p[0] = p_start;
   std::copy(nodes.begin(), nodes.end(), power_fit.p.begin() + 1);
 }
@@ -512,15 +552,11 @@ EnergyLedger ReferenceModel::energy_ledger() const {
       const Impl::PowerFit& fit = m.power_fit;
       // The observed time lies in the last booked interval (advance_to stops in it); the
       // quadrature of [t_obs, ledger_t] stays as the fallback should it ever not.
-      bool done = false;
-      if (fit.valid && fit.b == m.ledger_t && fit.a <= t_obs_) {
-        const Vec3 w = fit.work_to_end(t_obs_, true);
-        if ((w - fit.work_to_end(t_obs_, false)).cwiseAbs().maxCoeff() <= m.fit_tolerance) {
-          m.ledger_obs.add_contact_work(w);
-          done = true;
-        }
-      }
-      if (!done) m.ledger_obs.add_contact_work(-m.friction_work(t_obs_, m.ledger_t));
+      Vec3 w;
+      if (fit.valid && fit.b == m.ledger_t && fit.a <= t_obs_ && m.fitted_work_to_end(t_obs_, w))
+        m.ledger_obs.add_contact_work(w);
+      else
+        m.ledger_obs.add_contact_work(-m.friction_work(t_obs_, m.ledger_t));
     }
     m.ledger_obs_valid = true;
   }

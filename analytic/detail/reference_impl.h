@@ -129,7 +129,18 @@ struct ReferenceModel::Impl {
     // The work from t in [a, b] to b of the interpolated power: through all seven values
     // (`with_start`) or through the last six.
     Vec3 work_to_end(double t, bool with_start) const;
+    // The first, where the two agree to `tolerance`.
+    bool trusted_work_to_end(double t, double tolerance, Vec3& work) const;
   } power_fit;
+  // The same on either half of power_fit's interval, fitted on demand (refine_power_fit: ten
+  // contact solves) once a second sample of the step finds power_fit not trusted; the first
+  // takes the quadrature (five), so a step sampled once costs no more than before.
+  std::array<PowerFit, 2> power_halves{};
+  int fit_misses = 0;  // samples of power_fit's interval that did not trust it
+  void refine_power_fit();
+  // The work from t (in power_fit's interval) to its end from power_fit or its halves, where
+  // trusted; false where the caller takes the quadrature.
+  bool fitted_work_to_end(double t, Vec3& work);
   Vec3 p_start = Vec3::Zero();  // the contact power at the stepper's current time
   double fit_tolerance = 0.0;   // in energy, set at the start: see kFitTolerance
   double graze_lo = std::numeric_limits<double>::infinity(), graze_hi = -std::numeric_limits<double>::infinity();
