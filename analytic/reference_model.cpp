@@ -414,8 +414,9 @@ ReferenceModel::ReferenceModel(const Scene& scene, const BodyState& x_start) : b
 // from them (PowerFit), as a share of the scene's energy scale M v_scale^2. 1e-13: four orders
 // below the ledger's closure bound (1e-9 E0) and below its Gauss-5 booking error on
 // Bulirsch-Stoer (~7e-10 E0). Measured on every shipped scene against the per-sample quadrature
-// it replaces: the samples' ledgers move by at most 8e-11 E0 (rutstam_gliding_ball; 1e-13 ..
-// 1e-11 E0 on the others), the run's final ledger by round-off (BENCHMARKS.md, issue 29).
+// it replaces: the samples' ledgers move by at most 8e-11 E0 (rutstam_gliding_ball; 99 % of
+// every scene's samples by less than 1e-12 E0), the run's final ledger by round-off
+// (BENCHMARKS.md, "A sample's energy ledger without a contact solve").
 constexpr double kFitTolerance = 1e-13;
 
 void ReferenceModel::start(const Scene& scene, const BodyState& x0, bool in_flight) {

@@ -121,7 +121,8 @@ struct ReferenceModel::Impl {
   // Gauss nodes the booking evaluated and at b (the end's check point or event): a sample inside
   // the interval takes the work from its time to b from their interpolant, with no contact solve
   // of its own, where that agrees with the interpolant without a's value to fit_tolerance;
-  // otherwise the quadrature of [t, b], as every sample did before (ReferenceModel::energy_ledger).
+  // otherwise from power_halves, or the quadrature of [t, b] as every sample did before
+  // (ReferenceModel::energy_ledger).
   struct PowerFit {
     bool valid = false;
     double a = 0.0, b = 0.0;
