@@ -31,6 +31,15 @@ struct EvFn {
 // resolves the bounces above it alike and makes the same decisions.
 inline constexpr double kHoldApex = 1e-6;
 
+// How far apart the two interpolants' work to the step's end may be where a sample takes it
+// from them (ReferenceModel::Impl::PowerFit, reference_ledger.cpp), as a share of the scene's
+// energy scale M v_scale^2. 1e-13: four orders below the ledger's closure bound (1e-9 E0) and
+// below its Gauss-5 booking error on Bulirsch-Stoer (~7e-10 E0). Measured on every shipped scene against the per-sample quadrature
+// it replaces: the samples' ledgers move by at most 8e-11 E0 (rutstam_gliding_ball; 99 % of
+// every scene's samples by less than 1e-12 E0), the run's final ledger by round-off
+// (BENCHMARKS.md, "A sample's energy ledger without a contact solve").
+inline constexpr double kFitTolerance = 1e-13;
+
 inline const char* slot_name(int s) { return s == 0 ? "ball" : "stem"; }
 
 inline Surface surface_of(const ContactMode& m) {
@@ -48,7 +57,8 @@ inline std::string fmt(double v) {
 }  // namespace reference_detail
 
 // Integration and observation: reference_model.cpp; event functions and their handling:
-// reference_events.cpp; contact modes, projections and the run's end: reference_modes.cpp.
+// reference_events.cpp; contact modes, projections and the run's end: reference_modes.cpp; the
+// energy ledger's contact work: reference_ledger.cpp.
 struct ReferenceModel::Impl {
   using DenseStepper = reference_detail::DenseStepper;
   using System = reference_detail::System;
