@@ -35,17 +35,21 @@ inline bool digits17(double a, std::uint64_t& n, int& x) {
   x = static_cast<int>(std::floor((e2 - 1) * 0.30102999566398120));  // floor(log10(a)), or one below
   for (int pass = 0; pass < 2; ++pass) {
     const int k = 16 - x;
-    if (k < -27 || k > 27) return false;
-    const long double s = k >= 0 ? static_cast<long double>(a) * powers_of_ten()[k]
-                                 : static_cast<long double>(a) / powers_of_ten()[-k];
+    if (k < -27 || k > 54) return false;
+    // One exact power (10^27 at most) or, for numbers down to 1e-38 (the ledger's small terms),
+    // two: one rounding or two, each within 2^-64 relative.
+    const long double s = k > 27    ? static_cast<long double>(a) * powers_of_ten()[27] * powers_of_ten()[k - 27]
+                          : k >= 0 ? static_cast<long double>(a) * powers_of_ten()[k]
+                                   : static_cast<long double>(a) / powers_of_ten()[-k];
     if (s >= 1e17L) {
       ++x;
       continue;
     }
     if (s < 1e16L) return false;  // the estimate is never high; not expected
-    // s is a (10^k) rounded once: within half an ulp, 2^-8 below 2^57 > 1e17. Its fraction is
-    // exact; away from 1/2 by more than that error, the nearest integer of the exact product
-    // is that of s. Near 1/2 (a tie or close to one) the exact rounding is left to to_chars.
+    // s is a 10^k rounded once or twice: within 2^-63 relative, 0.016 below 2^57 > 1e17. Its
+    // fraction is exact; away from 1/2 by more than that error, the nearest integer of the
+    // exact product is that of s. Near 1/2 (a tie or close to one) the exact rounding is left
+    // to to_chars.
     const long double fl = std::floor(s);
     const long double frac = s - fl;
     if (frac > 0.48L && frac < 0.52L) return false;
@@ -65,7 +69,7 @@ inline bool digits17(double a, std::uint64_t& n, int& x) {
 // same bytes: "%.17g" in the C locale) and returns the end of what it wrote; end - p must be
 // at least 32. The trajectory writes 33 numbers per sample this way: libstdc++'s to_chars at a
 // given precision takes ~600 instructions a number; this path takes about a tenth of that for
-// numbers between 1e-11 and 1e43 and zeros, and hands the rest, infinities and NaNs (and the few
+// numbers between 1e-38 and 1e43 and zeros, and hands the rest, infinities and NaNs (and the few
 // numbers whose 18th digit is close to a tie) to to_chars.
 inline char* g17(char* p, char* end, double v) {
   if (v == 0.0) {  // "0" or "-0"

@@ -32,8 +32,8 @@ TEST(G17, SpecialValuesAndLayouts) {
 
 TEST(G17, RandomDoublesOfEveryExponent) {
   // Uniform bit patterns (every exponent alike, most outside the fast path's range), then
-  // numbers of the trajectory's sizes (1e-12 .. 1e6, either sign), then short decimals (the
-  // fast path's near-ties: x.5 at the 18th digit), 500,000 each.
+  // numbers of the trajectory's sizes (1e-40 .. 1e6, either sign: the ledger's small terms go
+  // far below 1e-11, the two-power path), then short decimals of the same sizes, 500,000 each.
   std::mt19937_64 rng(29);
   int mismatches = 0;
   auto check = [&](double v) {
@@ -46,7 +46,7 @@ TEST(G17, RandomDoublesOfEveryExponent) {
     check(v);
   }
   std::uniform_real_distribution<double> mant(1.0, 10.0);
-  std::uniform_int_distribution<int> exp10(-12, 6);
+  std::uniform_int_distribution<int> exp10(-40, 6);
   for (int i = 0; i < 500000; ++i) check((i % 2 ? -1 : 1) * mant(rng) * std::pow(10.0, exp10(rng)));
   std::uniform_int_distribution<std::int64_t> digits(1, 999999999);
   for (int i = 0; i < 500000; ++i) check(static_cast<double>(digits(rng)) * std::pow(10.0, exp10(rng)));
