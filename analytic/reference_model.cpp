@@ -39,9 +39,10 @@ void ReferenceModel::Impl::track_graze(const GrazeNote& n) {
   graze_violation = std::max(graze_violation, n.violation);
 }
 
-std::vector<double> ReferenceModel::Impl::g_all(const StateVector& y) {
+std::vector<double> ReferenceModel::Impl::g_all(const StateVector& y, Vec3* power) {
   const ContactForces f = forces_at(y, mode);
   note_forces(f);
+  if (power) *power = contact_power(y, f);
   std::vector<double> out(fns.size());
   for (size_t i = 0; i < fns.size(); ++i) out[i] = g(fns[i], y, &f);
   return out;
@@ -74,53 +75,6 @@ ContactForces ReferenceModel::Impl::forces_at_noted(const StateVector& y) {
   return f;
 }
 
-// Power of the contact forces and torques on the body (<= 0 for a dissipative law; the
-// normal force's share is its work on the drift of a held contact, tolerance-sized).
-// Per part: (normal force along +z, tangential force, drilling torque), for the energy ledger's split.
-Vec3 ReferenceModel::Impl::contact_power(const StateVector& y) {
-  const ContactForces f = forces_at(y, mode);
-  const BodyState x = unpack(y, 0);
-  const double wz = (x.q_WB.normalized() * x.w_B).z();
-  Vec3 p = Vec3::Zero();
-  for (int s = 0; s < 2; ++s) {
-    if (!mode.slot[s].active) continue;
-    const Vec3 v = dyn.contact_velocity(x, s);
-    const Vec3& F = f.force_W[s];
-    p += Vec3(F.z() * v.z(), F.x() * v.x() + F.y() * v.y(), f.drill_torque[s] * wz);
-  }
-  return p;
-}
-
-// Friction work over [a, b] inside the last step (dense output), 5-point Gauss-Legendre
-// (exact to degree 9). Every mode change ends an interval, so the power is smooth on it;
-// measured against E(t) the ledger closes to ~1e-11 E0 (dopri5) and ~7e-10 E0 (bulirsch_stoer,
-// whose own energy error near the end of a graze is that size, see GrazePinch).
-Vec3 ReferenceModel::Impl::gauss5(double a, double b) {
-  static constexpr double xg[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
-  static constexpr double wg[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665, 0.2369268850561891};
-  const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
-  Vec3 sum = Vec3::Zero();
-  for (int i = 0; i < 5; ++i) sum += wg[i] * contact_power(state_at(mid + half * xg[i]));
-  return half * sum;
-}
-
-Vec3 ReferenceModel::Impl::friction_work(double a, double b) {
-  if (!(b > a) || !mode.any_active()) return Vec3::Zero();
-  return -gauss5(a, b);
-}
-
-void EnergyLedger::add_contact_work(const Vec3& against) {
-  friction += against.sum();
-  normal += against.x();
-  tangential += against.y();
-  drilling += against.z();
-}
-
-void ReferenceModel::Impl::accumulate_friction_work(double a, double b) {
-  ledger.add_contact_work(friction_work(a, b));
-  ledger_t = b;
-}
-
 // Second derivative of the gap of slot k (acceleration of its sphere centre along z).
 double ReferenceModel::Impl::gap_acceleration(const StateVector& y, const ContactMode& m, int k) {
   StateVector dy;
@@ -139,7 +93,7 @@ void ReferenceModel::Impl::restart(double t, const StateVector& y, double first_
   stepper.initialize(y, t, dt);
   build_event_functions();
   refresh_references(y);
-  g_start = g_all(y);
+  g_start = g_all(y, &p_start);
   // A contact that starts to slide from zero slip starts on the positive side of its
   // SlipReversal function (0 there): the continuation's flip of the direction makes a slip
   // that grows against the reference a self-consistent motion in which the force drives the
@@ -152,6 +106,7 @@ void ReferenceModel::Impl::restart(double t, const StateVector& y, double first_
   track_graze(graze_last);
   pending = false;
   ledger_t = t;
+  power_fit.valid = false;
 }
 
 void ReferenceModel::Impl::step() {
@@ -165,6 +120,8 @@ void ReferenceModel::Impl::step() {
       for (int i = 6; i < 10; ++i) y[i] /= n;
       stepper.initialize(y, stepper.current_time(), stepper.current_time_step());
       ++owner.rhs_evals_;
+      // p_start stays: the power at the state before, off by the ~1e-13 relative of the
+      // renormalization (a node of the interpolant only; the booking does not use it).
     }
   }
   // Plain names, not a structured binding: the lambda below captures them, which C++17
@@ -186,16 +143,18 @@ void ReferenceModel::Impl::step() {
   std::vector<double> t_chk;
   std::vector<GrazeNote> raw_chk;
   std::vector<std::vector<double>> g_chk;
+  std::vector<Vec3> p_chk;  // the contact power at the check points
   auto sample = [&](int n_checks) {
     t_chk.assign(n_checks + 1, t0);
     raw_chk.assign(n_checks + 1, GrazeNote{});
     g_chk.assign(n_checks + 1, g_start);
+    p_chk.assign(n_checks + 1, p_start);
     for (int k = 1; k <= n_checks; ++k) {
       t_chk[k] = k == n_checks ? t1 : t0 + (t1 - t0) * k / n_checks;
       StateVector yk;
       if (k == n_checks) yk = y1;
       else stepper.calc_state(t_chk[k], yk);
-      g_chk[k] = g_all(yk);
+      g_chk[k] = g_all(yk, &p_chk[k]);
       raw_chk[k] = graze_last;
     }
   };
@@ -260,9 +219,15 @@ void ReferenceModel::Impl::step() {
   for (size_t k = 1; k < t_chk.size(); ++k)
     if (t_chk[k] <= (best >= 0 ? best_t : t1)) track_graze(raw_chk[k]);
   if (best >= 0) {
-    note_forces(forces_at(state_at(best_t), mode));
+    const StateVector yb = state_at(best_t);
+    const ContactForces fb = forces_at(yb, mode);
+    note_forces(fb);
     track_graze(graze_last);
+    power_fit.p[6] = contact_power(yb, fb);
+  } else {
+    power_fit.p[6] = p_chk[n_checks];
   }
+  power_fit.valid = true;
   if (best >= 0) {
     pending = true;
     pending_fn = fns[best];
@@ -270,6 +235,7 @@ void ReferenceModel::Impl::step() {
     return;
   }
   g_start = g1;
+  p_start = p_chk[n_checks];
   refresh_references(y1);
 }
 
@@ -295,6 +261,7 @@ void ReferenceModel::start(const Scene& scene, const BodyState& x0, bool in_flig
   impl_->slip_eps = std::max(1e-7, 10.0 * scene.run.rtol) * v_scale;
   impl_->coupled_floor = 1e-3 * impl_->slip_eps * scene.contact.mu;
   impl_->slip_start_v = impl_->slip_eps;
+  impl_->fit_tolerance = kFitTolerance * body_.M * v_scale * v_scale;
   const double period = std::min(2 * M_PI / std::max(x0.w_B.norm(), 1e-9), std::sqrt(body_.R / body_.g));
   impl_->dt_hint = 1e-3 * period;
   if (scene.contact.friction == FrictionLaw::Viscous && scene.contact.k > 0 && scene.run.method != "rosenbrock4") {
@@ -408,18 +375,6 @@ double ReferenceModel::raw_quaternion_norm() const {
 ContactForces ReferenceModel::forces() const { return impl_->dyn.evaluate(impl_->y_obs, impl_->mode, nullptr); }
 
 Surface ReferenceModel::contact_surface() const { return surface_of(impl_->mode); }
-
-EnergyLedger ReferenceModel::energy_ledger() const {
-  // On demand: the friction work from the observed time to the end of what is booked, on the
-  // last step's dense output (costs a quadrature, so not at every observation).
-  Impl& m = *impl_;
-  if (!m.ledger_obs_valid) {
-    m.ledger_obs = m.ledger;
-    if (status_ == ReferenceStatus::Ok && t_obs_ < m.ledger_t) m.ledger_obs.add_contact_work(-m.friction_work(t_obs_, m.ledger_t));
-    m.ledger_obs_valid = true;
-  }
-  return m.ledger_obs;
-}
 
 std::pair<double, double> ReferenceModel::graze_fraction_range() const { return {impl_->graze_lo, impl_->graze_hi}; }
 

@@ -31,6 +31,15 @@ struct EvFn {
 // resolves the bounces above it alike and makes the same decisions.
 inline constexpr double kHoldApex = 1e-6;
 
+// How far apart the two interpolants' work to the step's end may be where a sample takes it
+// from them (ReferenceModel::Impl::PowerFit, reference_ledger.cpp), as a share of the scene's
+// energy scale M v_scale^2. 1e-13: four orders below the ledger's closure bound (1e-9 E0) and
+// below its Gauss-5 booking error on Bulirsch-Stoer (~7e-10 E0). Measured on every shipped scene against the per-sample quadrature
+// it replaces: the samples' ledgers move by at most 8e-11 E0 (rutstam_gliding_ball; 99 % of
+// every scene's samples by less than 1e-12 E0), the run's final ledger by round-off
+// (BENCHMARKS.md, "A sample's energy ledger without a contact solve").
+inline constexpr double kFitTolerance = 1e-13;
+
 inline const char* slot_name(int s) { return s == 0 ? "ball" : "stem"; }
 
 inline Surface surface_of(const ContactMode& m) {
@@ -48,7 +57,8 @@ inline std::string fmt(double v) {
 }  // namespace reference_detail
 
 // Integration and observation: reference_model.cpp; event functions and their handling:
-// reference_events.cpp; contact modes, projections and the run's end: reference_modes.cpp.
+// reference_events.cpp; contact modes, projections and the run's end: reference_modes.cpp; the
+// energy ledger's contact work: reference_ledger.cpp.
 struct ReferenceModel::Impl {
   using DenseStepper = reference_detail::DenseStepper;
   using System = reference_detail::System;
@@ -117,6 +127,33 @@ struct ReferenceModel::Impl {
   EnergyLedger ledger_obs;  // the same at the observed time, when ledger_obs_valid
   bool ledger_obs_valid = true;
   double ledger_t = 0.0;
+  // The contact power over the last booked interval [a, b] (b = ledger_t), at a, at the five
+  // Gauss nodes the booking evaluated and at b (the end's check point or event): a sample inside
+  // the interval takes the work from its time to b from their interpolant, with no contact solve
+  // of its own, where that agrees with the interpolant without a's value to fit_tolerance;
+  // otherwise from power_halves, or the quadrature of [t, b] as every sample did before
+  // (ReferenceModel::energy_ledger).
+  struct PowerFit {
+    bool valid = false;
+    double a = 0.0, b = 0.0;
+    std::array<Vec3, 7> p{};  // at a, at the Gauss nodes of [a, b], at b
+    // The work from t in [a, b] to b of the interpolated power: through all seven values
+    // (`with_start`) or through the last six.
+    Vec3 work_to_end(double t, bool with_start) const;
+    // The first, where the two agree to `tolerance`.
+    bool trusted_work_to_end(double t, double tolerance, Vec3& work) const;
+  } power_fit;
+  // The same on either half of power_fit's interval, fitted on demand (refine_power_fit: ten
+  // contact solves) once a second sample of the step finds power_fit not trusted; the first
+  // takes the quadrature (five), so a step sampled once costs no more than before.
+  std::array<PowerFit, 2> power_halves{};
+  int fit_misses = 0;  // samples of power_fit's interval that did not trust it
+  void refine_power_fit();
+  // The work from t (in power_fit's interval) to its end from power_fit or its halves, where
+  // trusted; false where the caller takes the quadrature.
+  bool fitted_work_to_end(double t, Vec3& work);
+  Vec3 p_start = Vec3::Zero();  // the contact power at the stepper's current time
+  double fit_tolerance = 0.0;   // in energy, set at the start: see kFitTolerance
   double graze_lo = std::numeric_limits<double>::infinity(), graze_hi = -std::numeric_limits<double>::infinity();
   bool singular = false;  // a check point met a contact system without a unique solution
 
@@ -157,7 +194,8 @@ struct ReferenceModel::Impl {
   void track_graze(const GrazeNote& n);
   double graze_violation = 0.0;
 
-  std::vector<double> g_all(const StateVector& y);
+  // The event functions at y; `power`: the contact power there too, from the same forces.
+  std::vector<double> g_all(const StateVector& y, Vec3* power = nullptr);
 
   StateVector state_at(double t);
 
@@ -166,9 +204,11 @@ struct ReferenceModel::Impl {
   ContactForces forces_at_noted(const StateVector& y);
 
   Vec3 contact_power(const StateVector& y);
+  Vec3 contact_power(const StateVector& y, const ContactForces& f) const;
 
-  Vec3 gauss5(double a, double b);
-  Vec3 friction_work(double a, double b);
+  // `nodes`: where given, the power at the five Gauss nodes (zero where no contact is held).
+  Vec3 gauss5(double a, double b, std::array<Vec3, 5>* nodes = nullptr);
+  Vec3 friction_work(double a, double b, std::array<Vec3, 5>* nodes = nullptr);
   void accumulate_friction_work(double a, double b);
 
   double gap_acceleration(const StateVector& y, const ContactMode& m, int k);

@@ -21,6 +21,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "io/g17.h"
 #include "io/provenance.h"
 
 namespace tippe {
@@ -395,7 +396,7 @@ size_t format_trajectory_row(const Observation& o, char* line) {
     if (i == surface_column) {
       for (const char* s = to_string(o.surface); *s;) *p++ = *s++;
     } else {
-      p = std::to_chars(p, end, values[i], std::chars_format::general, 17).ptr;
+      p = g17(p, end, values[i]);  // std::to_chars(general, 17)'s bytes, faster
     }
   }
   *p++ = '\n';
