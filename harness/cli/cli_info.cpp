@@ -1,4 +1,4 @@
-// `tippe info`: a scene's mass properties, the inversion condition and every engine's settings in force; `tippe info --markdown`: every engine's settings as docs/engines.md lists them.
+// `tippe info`: a scene's mass properties, the inversion condition and every engine's settings in force; `--markdown`: every engine's settings as docs/engines.md lists them; `--metrics`: the metric table; `--schema NAME`: a record's generated schema.
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -7,6 +7,8 @@
 #include "mass_properties.h"
 #include "registry.h"
 #include "io/scene_io.h"
+#include "records/comparison.h"
+#include "records/record_schemas.h"
 #include "simulator.h"
 
 namespace tippe::cli {
@@ -17,6 +19,8 @@ struct InfoOptions {
   std::string scene;
   std::vector<std::string> sets;
   bool markdown = false;
+  bool metrics = false;
+  std::string schema;
 };
 
 // A Markdown table cell: '|' escaped.
@@ -58,6 +62,15 @@ int engines_markdown() {
 
 std::string setting_text(const SettingValue& v) { return setting_to_json(v).dump(); }
 
+// The metric table: every number of a comparison's metrics (Metrics' `visit`), its unit and
+// meaning, and whether a gate's [check.max] or a sweep's criterion may bound it.
+int metrics_table() {
+  std::printf("| metric | bounded by gates and sweeps | unit and meaning |\n|---|---|---|\n");
+  for (const FieldInfo& f : field_list<Metrics>())
+    if (f.number) std::printf("| `%s` | %s | %s |\n", f.key.c_str(), f.bounded ? "yes" : "no", md(f.doc).c_str());
+  return 0;
+}
+
 }  // namespace
 
 std::string inversion_condition_text(double alpha, double ratio) {
@@ -79,7 +92,17 @@ namespace {
 
 int info(const InfoOptions& o) {
   if (o.markdown) return engines_markdown();
-  if (o.scene.empty()) throw UsageError("info: a scene file is required (or --markdown: every engine's settings)");
+  if (o.metrics) return metrics_table();
+  if (!o.schema.empty()) {
+    try {
+      std::fputs(record_schema_text(o.schema).c_str(), stdout);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("info: --schema: ") + e.what());
+    }
+    return 0;
+  }
+  if (o.scene.empty())
+    throw UsageError("info: a scene file is required (or --markdown: every engine's settings, --metrics, --schema NAME)");
   const Scene s = load_scene(o.scene, o.sets);
   const MassProperties& m = s.mass;
   const double R = s.body.sphere_radius;
@@ -132,6 +155,11 @@ Command setup_info(CLI::App& app) {
   sub->add_option("--set", o->sets, "Override a scene key, e.g. contact.mu=0.5 (repeatable)")->allow_extra_args(false)->take_all();
   sub->add_flag("--markdown", o->markdown,
                 "Print every engine's settings (key, type, default, accepted values) as Markdown: docs/engines.md");
+  sub->add_flag("--metrics", o->metrics,
+                "Print the metric table: every metric of a comparison, whether gates and sweeps may bound it, its unit");
+  sub->add_option("--schema", o->schema,
+                  "Print the JSON Schema generated from a record's field list: run-summary or comparison "
+                  "(schemas/NAME.schema.json)");
   return {sub, [o] { return info(*o); }};
 }
 

@@ -68,6 +68,154 @@ struct Metrics {
   std::optional<long long> event_alignment_rows;  // how many pairs the whole alignment has
 };
 
+// The values an aligned row's op may hold.
+const std::vector<std::string>& aligned_event_ops();
+
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, AlignedEventRow>> visit(R& r, V& v) {
+  v(Field("op").one_of(aligned_event_ops()), r.op);
+  v(Field("reference").since().empty_as_null(), r.reference_kind);
+  v(Field("t_reference").since(), r.reference_time);
+  v(Field("engine").since().empty_as_null(), r.engine_kind);
+  v(Field("t_engine").since(), r.engine_time);
+}
+
+// The metrics' one field list: comparison.json's "metrics" objects, their schema, and the
+// metric table a bound may name (metric_bounds.h: every number here but those `not_bounded`, in
+// this order, which is the order of a gate's rows). Fields `since` a later format read as absent
+// from records written before them.
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Metrics>> visit(R& m, V& v) {
+  v(Field("inversion_event", "both, neither, engine_only or reference_only: which runs have an inversion"),
+    m.inversion_event);
+  v(Field("inversion_time_abs_error", "s, engine - reference"), m.inversion_time_abs_error);
+  v(Field("inversion_time_rel_error", "fraction of the reference's time"), m.inversion_time_rel_error);
+  v(Field("stem_contact_event", "both, neither, engine_only or reference_only: which runs touch the stem"),
+    m.stem_contact_event);
+  v(Field("stem_contact_time_abs_error", "s, engine - reference"), m.stem_contact_time_abs_error);
+  v(Field("stem_contact_time_rel_error", "fraction of the reference's time"), m.stem_contact_time_rel_error);
+  v(Field("tilt_max_error", "rad"), m.tilt_max_error);
+  v(Field("tilt_rms_error", "rad"), m.tilt_rms_error);
+  v(Field("energy_max_error", "/ E0"), m.energy_max_error);
+  v(Field("energy_final_ratio", "E_final / E0 of the engine"), m.energy_final_ratio);
+  v(Field("energy_gain_events", "count"), m.energy_gain_events);
+  v(Field("energy_max_gain", "/ E0"), m.energy_max_gain);
+  static const std::vector<std::string> rules = {"ledger", "total"};
+  v(Field("energy_gain_rule",
+          "how energy_gain_events and energy_max_gain counted energy (harness/measure/metrics.h): ledger (energy "
+          "created by the ledger's account) or total (E); absent in records written before it")
+        .since()
+        .one_of(rules),
+    m.energy_gain_rule);
+  v(Field("numerical_energy_max",
+          "energy ledger (docs/energy-ledger.md): largest |numerical energy| N = E - E0 - work + impacts, / |E0| of "
+          "the engine's run; null: not available")
+        .since(),
+    m.numerical_energy_max);
+  v(Field("numerical_energy_final",
+          "energy ledger (docs/energy-ledger.md): numerical energy at the end, / |E0| of the engine's run; null: not "
+          "available")
+        .since(),
+    m.numerical_energy_final);
+  v(Field("friction_work",
+          "energy ledger (docs/energy-ledger.md): work of the friction forces on the top, / |E0| of the engine's run; "
+          "null: not available")
+        .since(),
+    m.friction_work);
+  v(Field("normal_work",
+          "energy ledger (docs/energy-ledger.md): work of the normal forces on the top, / |E0| of the engine's run; "
+          "null: not available")
+        .since(),
+    m.normal_work);
+  v(Field("drilling_work",
+          "energy ledger (docs/energy-ledger.md): work of the drilling and rolling torques, / |E0| of the engine's "
+          "run; null: not available")
+        .since(),
+    m.drilling_work);
+  v(Field("impact_energy",
+          "energy ledger (docs/energy-ledger.md): energy removed at impacts, / |E0| of the engine's run; null: not "
+          "available")
+        .since(),
+    m.impact_energy);
+  v(Field("elastic_energy_max",
+          "energy ledger (docs/energy-ledger.md): largest elastic energy stored in the contact, / |E0| of the "
+          "engine's run; null: not available")
+        .since(),
+    m.elastic_energy_max);
+  v(Field("contact_path_rms_error", "/ R"), m.contact_path_rms_error);
+  v(Field("contact_path_max_error", "/ R"), m.contact_path_max_error);
+  v(Field("com_path_rms_error", "/ R"), m.com_path_rms_error);
+  v(Field("com_path_max_error", "/ R"), m.com_path_max_error);
+  v(Field("latitude_rms_error", "rad"), m.latitude_rms_error);
+  v(Field("jellett_drift_ball", "relative"), m.jellett_drift_ball);
+  v(Field("jellett_drift_stem", "relative"), m.jellett_drift_stem);
+  v(Field("jellett_max_relative_drift", "relative"), m.jellett_max_relative_drift);
+  // Timing is never bounded: it depends on the machine and its load (cost_ratio, a ratio of CPU
+  // times on the same machine, is).
+  v(Field("wall_seconds", "s").not_bounded(), m.wall_seconds);
+  v(Field("cpu_seconds", "s").not_bounded(), m.cpu_seconds);
+  v(Field("real_time_factor", "simulated s per wall s").not_bounded(), m.real_time_factor);
+  v(Field("steps", "engine steps"), m.steps);
+  v(Field("cost_ratio", "engine CPU / reference CPU"), m.cost_ratio);
+  v(Field("compared_until", "s"), m.compared_until);
+  // The reference's, not the engine's: it marks a gate's rows instead.
+  v(Field("reference_converged_until",
+          "s: end of the reference's converged window when the metrics stop there; null: compared over the whole "
+          "common grid")
+        .since()
+        .minimum(0)
+        .not_bounded(),
+    m.reference_converged_until);
+  v(Field("event_time_max_error", "largest |t_engine - t_reference| of matched events (0 when none is matched)")
+        .since()
+        .minimum(0),
+    m.event_time_max_error);
+  // The event alignment: the counts on each side and of matches describe the sequences (missing
+  // and extra judge them), the first wrong event is a text (require_no_wrong_event gates it), the
+  // dwell is a setting of the bench.
+  v(Field("events_reference",
+          "canonical events of the reference in the compared window (absent in records older than the event "
+          "alignment)")
+        .since()
+        .minimum(0)
+        .not_bounded(),
+    m.events_reference);
+  v(Field("events_engine", "canonical events of the engine in the compared window").since().minimum(0).not_bounded(),
+    m.events_engine);
+  v(Field("events_matched", "aligned pairs of the same kind; events_matched + events_missing = events_reference")
+        .since()
+        .minimum(0)
+        .not_bounded(),
+    m.events_matched);
+  v(Field("events_missing", "reference events the engine lacks (a substitution counts one missing and one extra)")
+        .since()
+        .minimum(0),
+    m.events_missing);
+  v(Field("events_extra", "engine events the reference lacks").since().minimum(0), m.events_extra);
+  v(Field("first_wrong_event_index",
+          "index in the aligned sequence of the first pair that is not a match; null when none")
+        .since()
+        .minimum(0)
+        .not_bounded(),
+    m.first_wrong_event_index);
+  v(Field("first_wrong_event",
+          "\"reference: KIND at t=T, engine: KIND at t=T\" (a side without an event there reads \"none\"); null when "
+          "the sequences agree")
+        .since()
+        .empty_as_null(),
+    m.first_wrong_event);
+  v(Field("events_not_compared", "events left out of the comparison, counted by name and side").since(),
+    m.events_not_compared);
+  v(Field("event_min_dwell", "surface phases shorter than this were merged on both sides (a setting of the bench)")
+        .since()
+        .minimum(0)
+        .not_bounded(),
+    m.event_min_dwell);
+  v(Field("event_alignment", "the first 20 aligned pairs (kMaxAlignedEventRowsKept)").since(), m.event_alignment);
+  v(Field("event_alignment_rows", "how many aligned pairs the whole alignment has").since().minimum(0).not_bounded(),
+    m.event_alignment_rows);
+}
+
 nlohmann::json to_json(const Metrics& m);
 Metrics metrics_from_json(const nlohmann::json& j);
 

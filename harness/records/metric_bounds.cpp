@@ -3,56 +3,70 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
 
 #include "io/scene_io.h"
 #include "io/text.h"
 
 namespace tippe {
 
-#define TIPPE_GATE_VALUE(field, unit) \
-  {#field, [](const Metrics& m) -> std::optional<double> { return static_cast<double>(m.field); }, unit}
-#define TIPPE_GATE_OPTIONAL(field, unit) \
-  {#field, [](const Metrics& m) -> std::optional<double> { return m.field; }, unit}
+namespace {
+
+// The value of one numeric field of Metrics, found by its key in Metrics' `visit`.
+class MetricValue {
+ public:
+  explicit MetricValue(std::string key) : key_(std::move(key)) {}
+  void operator()(const Field& f, const double& v) { take(f, v); }
+  void operator()(const Field& f, const long long& v) { take(f, static_cast<double>(v)); }
+  void operator()(const Field& f, const std::optional<double>& v) {
+    if (key_ == f.key()) value = v;
+  }
+  void operator()(const Field& f, const std::optional<long long>& v) {
+    if (key_ == f.key() && v) value = static_cast<double>(*v);
+  }
+  template <class T>
+  void operator()(const Field&, const T&) {}
+  std::optional<double> value;
+
+ private:
+  void take(const Field& f, double v) {
+    if (key_ == f.key()) value = v;
+  }
+  std::string key_;
+};
+
+// The bounded numbers of Metrics' `visit`, keys and docs kept (string literals of `visit`).
+class BoundedMetrics {
+ public:
+  template <class T>
+  void operator()(const Field& f, const T&) {
+    using U = std::decay_t<T>;
+    if (f.bounded() && (std::is_same_v<U, double> || std::is_same_v<U, long long> ||
+                        std::is_same_v<U, std::optional<double>> || std::is_same_v<U, std::optional<long long>>))
+      table.push_back({f.key(),
+                       [key = std::string(f.key())](const Metrics& m) {
+                         MetricValue v(key);
+                         visit(m, v);
+                         return v.value;
+                       },
+                       f.doc()});
+  }
+  std::vector<GateMetric> table;
+};
+
+}  // namespace
 
 const std::vector<GateMetric>& gate_metrics() {
-  static const std::vector<GateMetric> table = {
-      TIPPE_GATE_OPTIONAL(inversion_time_abs_error, "s, engine - reference"),
-      TIPPE_GATE_OPTIONAL(inversion_time_rel_error, "fraction of the reference's time"),
-      TIPPE_GATE_OPTIONAL(stem_contact_time_abs_error, "s, engine - reference"),
-      TIPPE_GATE_OPTIONAL(stem_contact_time_rel_error, "fraction of the reference's time"),
-      TIPPE_GATE_VALUE(tilt_max_error, "rad"),
-      TIPPE_GATE_VALUE(tilt_rms_error, "rad"),
-      TIPPE_GATE_VALUE(energy_max_error, "/ E0"),
-      TIPPE_GATE_VALUE(energy_final_ratio, "E_final / E0 of the engine"),
-      TIPPE_GATE_VALUE(energy_gain_events, "count"),
-      TIPPE_GATE_VALUE(energy_max_gain, "/ E0"),
-      TIPPE_GATE_OPTIONAL(numerical_energy_max, "/ E0, largest |numerical energy| of the ledger (docs/energy-ledger.md)"),
-      TIPPE_GATE_OPTIONAL(numerical_energy_final, "/ E0, numerical energy of the ledger at the end"),
-      TIPPE_GATE_OPTIONAL(friction_work, "/ E0, work of the friction forces (|value| is compared)"),
-      TIPPE_GATE_OPTIONAL(normal_work, "/ E0, work of the normal forces (|value| is compared)"),
-      TIPPE_GATE_OPTIONAL(drilling_work, "/ E0, work of the drilling torques (|value| is compared)"),
-      TIPPE_GATE_OPTIONAL(impact_energy, "/ E0, energy removed at impacts (|value| is compared)"),
-      TIPPE_GATE_OPTIONAL(elastic_energy_max, "/ E0, largest elastic energy in the contact"),
-      TIPPE_GATE_VALUE(contact_path_rms_error, "/ R"),
-      TIPPE_GATE_VALUE(contact_path_max_error, "/ R"),
-      TIPPE_GATE_VALUE(com_path_rms_error, "/ R"),
-      TIPPE_GATE_VALUE(com_path_max_error, "/ R"),
-      TIPPE_GATE_VALUE(latitude_rms_error, "rad"),
-      TIPPE_GATE_OPTIONAL(jellett_drift_ball, "relative"),
-      TIPPE_GATE_OPTIONAL(jellett_drift_stem, "relative"),
-      TIPPE_GATE_VALUE(jellett_max_relative_drift, "relative"),
-      TIPPE_GATE_VALUE(steps, "engine steps"),
-      TIPPE_GATE_VALUE(cost_ratio, "engine CPU / reference CPU"),
-      TIPPE_GATE_VALUE(compared_until, "s"),
-      TIPPE_GATE_OPTIONAL(event_time_max_error, "s, largest over matched events (measure/event_alignment.h)"),
-      TIPPE_GATE_OPTIONAL(events_missing, "reference events the engine lacks (count)"),
-      TIPPE_GATE_OPTIONAL(events_extra, "engine events the reference lacks (count)"),
-  };
+  static const std::vector<GateMetric> table = [] {
+    BoundedMetrics b;
+    const Metrics m{};
+    visit(m, b);
+    return b.table;
+  }();
   return table;
 }
-
-#undef TIPPE_GATE_VALUE
-#undef TIPPE_GATE_OPTIONAL
 
 const GateMetric* find_gate_metric(const std::string& name) {
   for (const GateMetric& g : gate_metrics())

@@ -1,6 +1,7 @@
 // The metrics of a comparison record that a bound may name, and bounds written as text ("METRIC <= NUMBER"): shared by gates and sweep searches.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,15 +12,16 @@ namespace tippe {
 
 // ---- metrics a gate may bound --------------------------------------------------------------
 
-// A numeric field of Metrics a threshold can name. Wall-clock fields (wall_seconds,
-// cpu_seconds, real_time_factor) are left out on purpose: a gate must not depend on the machine
-// or on its load. cost_ratio is a ratio of CPU times on the same machine, so it stays.
+// A numeric field of Metrics a threshold can name: every number of Metrics' `visit` but those it
+// marks not_bounded (comparison.h says why: timing, which depends on the machine and its load;
+// counts that describe the event sequences; settings of the bench). cost_ratio is a ratio of CPU
+// times on the same machine, so it stays.
 struct GateMetric {
   const char* name;
-  std::optional<double> (*get)(const Metrics&);  // nullopt: absent in this comparison
-  const char* unit;                              // for the table's legend
+  std::function<std::optional<double>(const Metrics&)> get;  // nullopt: absent in this comparison
+  const char* unit;                                           // unit and meaning (the field's doc)
 };
-// Every gate metric, in the order tables and results list them.
+// Every gate metric, in the order of Metrics' `visit` (the order tables and results list them).
 const std::vector<GateMetric>& gate_metrics();
 // nullptr for a name that is not a gate metric.
 const GateMetric* find_gate_metric(const std::string& name);

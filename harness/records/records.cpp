@@ -131,81 +131,14 @@ void SampleSummary::fill(RunRecord& r) const {
 }
 
 json to_json(const RunRecord& r) {
-  json events = json::array();
-  for (const Event& e : r.events)
-    events.push_back({{"name", e.name}, {"time", number(e.time)}, {"detail", e.detail}, {"value", number(e.value)}});
-  json settings = json::object();
-  for (const auto& [k, v] : r.settings) settings[k] = v;
-  return json{
-      {"format", kRunRecordFormat},
-      {"scene", r.scene_name},
-      {"scene_file", r.scene_file},
-      {"scene_hash", r.scene_hash},
-      {"scene_spec", r.scene_spec},
-      {"engine", r.engine},
-      {"engine_version", r.engine_version},
-      {"status", r.status},
-      {"status_time", number(r.status_time)},
-      {"status_detail", r.status_detail},
-      {"inversion_time", number(r.inversion_time)},
-      {"stem_contact_time", number(r.stem_contact_time)},
-      {"samples", r.samples},
-      {"final_time", number(r.final_time)},
-      {"final_tilt", number(r.final_tilt)},
-      {"energy_initial", number(r.energy_initial)},
-      {"energy_final", number(r.energy_final)},
-      {"jellett_initial", number(r.jellett_initial)},
-      {"jellett_max_relative_drift", number(r.jellett_max_relative_drift)},
-      {"jellett_drift_ball", number(r.jellett_drift_ball)},
-      {"jellett_drift_stem", number(r.jellett_drift_stem)},
-      {"min_normal_force", number(r.min_normal_force)},
-      {"friction_work", number(r.friction_work)},
-      {"normal_work", number(r.normal_work)},
-      {"drilling_work", number(r.drilling_work)},
-      {"impact_energy", number(r.impact_energy)},
-      {"elastic_energy_max", number(r.elastic_energy_max)},
-      {"numerical_energy_max", number(r.numerical_energy_max)},
-      {"numerical_energy_final", number(r.numerical_energy_final)},
-      {"ledger_not_available", r.ledger_not_available},
-      {"ledger_at_inversion", r.ledger_at_inversion ? json{{"time", number(r.ledger_at_inversion->time)},
-                                                           {"energy", number(r.ledger_at_inversion->energy)},
-                                                           {"normal_work", number(r.ledger_at_inversion->normal_work)},
-                                                           {"friction_work", number(r.ledger_at_inversion->friction_work)},
-                                                           {"drilling_work", number(r.ledger_at_inversion->drilling_work)},
-                                                           {"impact_energy", number(r.ledger_at_inversion->impact_energy)},
-                                                           {"numerical_energy", number(r.ledger_at_inversion->numerical_energy)}}
-                                                    : json(nullptr)},
-      {"mass_properties",
-       {{"mass", number(r.mass.mass)},
-        {"com_offset", number(r.mass.com_offset)},
-        {"inertia_transverse", number(r.mass.inertia_transverse)},
-        {"inertia_axial", number(r.mass.inertia_axial)}}},
-      {"inversion_possible", r.inversion_possible},
-      {"work",
-       {{"steps", r.work.steps},
-        {"rhs_evaluations", r.work.rhs_evaluations},
-        {"solver_iterations", r.work.solver_iterations},
-        {"wall_seconds", number(r.work.wall_seconds)},
-        {"cpu_seconds", number(r.work.cpu_seconds)}}},
-      {"events", events},
-      {"settings", settings},
-      {"notes", r.notes},
-      {"provenance", to_json(r.provenance)},
-  };
+  json j = JsonWriter::write(r);
+  j["format"] = kRunRecordFormat;
+  return j;
 }
 
-json to_json(const Provenance& p) {
-  return {{"git_commit", p.git_commit},
-          {"compiler", p.compiler},
-          {"cxx_flags", p.cxx_flags},
-          {"date", p.date},
-          {"hostname", p.hostname}};
-}
+json to_json(const Provenance& p) { return JsonWriter::write(p); }
 
-Provenance provenance_from_json(const json& p) {
-  return {p.at("git_commit").get<std::string>(), p.at("compiler").get<std::string>(),
-          p.at("cxx_flags").get<std::string>(), p.at("date").get<std::string>(), p.at("hostname").get<std::string>()};
-}
+Provenance provenance_from_json(const json& p) { return JsonReader::read<Provenance>(p, ""); }
 
 long long json_integer(const json& j, const char* key) {
   const json& v = j.at(key);
@@ -234,21 +167,11 @@ const std::vector<std::string>& event_names() {
   return names;
 }
 
-namespace {
-
-// A string field of a record that must be one of `names`; the message names the field.
-std::string one_of(const json& j, const char* key, const std::string& where, const std::vector<std::string>& names) {
-  const std::string v = j.at(key).get<std::string>();
-  if (std::find(names.begin(), names.end(), v) != names.end()) return v;
-  std::string list;
-  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-  throw json::other_error::create(
-      501, where + key + ": " + json(v.substr(0, 40)).dump(-1, ' ', false, json::error_handler_t::replace) +
-               " is not one of " + list,
-      &j);
+const std::vector<std::string>& ledger_term_names() {
+  static const std::vector<std::string> names = {"normal_work", "friction_work", "drilling_work", "impact_energy",
+                                                 "elastic_energy"};
+  return names;
 }
-
-}  // namespace
 
 RunRecord from_json(const json& j) {
   // Summaries written before records carried a format have none; any other format is refused.
@@ -256,71 +179,7 @@ RunRecord from_json(const json& j) {
     throw json::other_error::create(
         501, "format: unknown record format " + j.at("format").dump().substr(0, 60) + " (expected " + kRunRecordFormat + ")",
         &j);
-  RunRecord r;
-  r.scene_name = j.at("scene").get<std::string>();
-  r.scene_file = j.at("scene_file").get<std::string>();
-  r.scene_hash = j.at("scene_hash").get<std::string>();
-  r.scene_spec = j.value("scene_spec", json());
-  r.engine = j.at("engine").get<std::string>();
-  r.engine_version = j.at("engine_version").get<std::string>();
-  r.status = one_of(j, "status", "", run_status_names());
-  r.status_time = get_number(j, "status_time");
-  r.status_detail = j.at("status_detail").get<std::string>();
-  r.inversion_time = get_optional(j, "inversion_time");
-  r.stem_contact_time = get_optional(j, "stem_contact_time");
-  r.samples = json_integer(j, "samples");
-  r.final_time = get_number(j, "final_time");
-  r.final_tilt = get_number(j, "final_tilt");
-  r.energy_initial = get_number(j, "energy_initial");
-  r.energy_final = get_number(j, "energy_final");
-  r.jellett_initial = get_number(j, "jellett_initial");
-  r.jellett_max_relative_drift = get_number(j, "jellett_max_relative_drift");
-  r.jellett_drift_ball = get_optional(j, "jellett_drift_ball");
-  r.jellett_drift_stem = get_optional(j, "jellett_drift_stem");
-  r.min_normal_force = get_number(j, "min_normal_force");
-  // Absent from records written before it: read as not reported.
-  r.friction_work = j.contains("friction_work") ? get_number(j, "friction_work") : kNaN;
-  const std::pair<const char*, double*> ledger[] = {{"normal_work", &r.normal_work},
-                                                     {"drilling_work", &r.drilling_work},
-                                                     {"impact_energy", &r.impact_energy},
-                                                     {"elastic_energy_max", &r.elastic_energy_max},
-                                                     {"numerical_energy_max", &r.numerical_energy_max},
-                                                     {"numerical_energy_final", &r.numerical_energy_final}};
-  for (const auto& [key, field] : ledger) *field = j.contains(key) ? get_number(j, key) : kNaN;
-  if (j.contains("ledger_not_available")) r.ledger_not_available = j.at("ledger_not_available").get<std::vector<std::string>>();
-  if (j.contains("ledger_at_inversion") && !j.at("ledger_at_inversion").is_null()) {
-    const json& p = j.at("ledger_at_inversion");
-    RunRecord::LedgerPoint lp;
-    lp.time = get_number(p, "time");
-    lp.energy = get_number(p, "energy");
-    lp.normal_work = get_number(p, "normal_work");
-    lp.friction_work = get_number(p, "friction_work");
-    lp.drilling_work = get_number(p, "drilling_work");
-    lp.impact_energy = get_number(p, "impact_energy");
-    lp.numerical_energy = get_number(p, "numerical_energy");
-    r.ledger_at_inversion = lp;
-  }
-  const json& m = j.at("mass_properties");
-  r.mass = {get_number(m, "mass"), get_number(m, "com_offset"), get_number(m, "inertia_transverse"),
-            get_number(m, "inertia_axial")};
-  r.inversion_possible = j.at("inversion_possible").get<bool>();
-  const json& w = j.at("work");
-  r.work.steps = json_integer(w, "steps");
-  r.work.rhs_evaluations = json_integer(w, "rhs_evaluations");
-  r.work.solver_iterations = json_integer(w, "solver_iterations");
-  r.work.wall_seconds = get_number(w, "wall_seconds");
-  r.work.cpu_seconds = get_number(w, "cpu_seconds");
-  for (const json& e : j.at("events"))
-    r.events.push_back({one_of(e, "name", "events[].", event_names()), get_number(e, "time"),
-                        e.at("detail").get<std::string>(), get_number(e, "value")});
-  for (const auto& [k, v] : j.at("settings").items()) {
-    if (!v.is_string())
-      throw json::other_error::create(501, "settings." + k.substr(0, 40) + ": expected a string, got " + v.type_name(), &j);
-    r.settings.emplace_back(k, v.get<std::string>());
-  }
-  r.notes = j.at("notes").get<std::vector<std::string>>();
-  r.provenance = provenance_from_json(j.at("provenance"));
-  return r;
+  return JsonReader::read<RunRecord>(j, "");
 }
 
 const std::vector<std::string>& trajectory_columns() {

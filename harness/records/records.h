@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/files.h"
+#include "records/fields.h"
 #include "scene.h"
 #include "simulator.h"
 
@@ -31,6 +32,14 @@ struct Provenance {
   std::string date;                             // UTC, ISO 8601, when the run started
   std::string hostname;
 };
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Provenance>> visit(R& p, V& v) {
+  v(Field("git_commit"), p.git_commit);
+  v(Field("compiler"), p.compiler);
+  v(Field("cxx_flags"), p.cxx_flags);
+  v(Field("date", "UTC, ISO 8601, when the run started"), p.date);
+  v(Field("hostname"), p.hostname);
+}
 // Build info plus the current date and host.
 Provenance current_provenance();
 // The "provenance" object of every record (run, comparison, sweep); the reader throws
@@ -96,6 +105,123 @@ struct RunRecord {
   std::optional<LedgerPoint> ledger_at_inversion;
 };
 
+// The ledger's terms a simulator may not give (RunRecord::ledger_not_available).
+const std::vector<std::string>& ledger_term_names();
+
+// ---- the field lists (records/fields.h): summary.json and its schema follow them ----------------
+
+// A simulator's event (engines/core/simulator.h) as a record lists it.
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Event>> visit(R& e, V& v) {
+  v(Field("name").one_of(event_names()), e.name);
+  v(Field("time", "s"), e.time);
+  v(Field("detail"), e.detail);
+  v(Field("value", "event-specific (e.g. J removed by an impact)"), e.value);
+}
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, MassProperties>> visit(R& m, V& v) {
+  v(Field("mass", "kg"), m.mass);
+  v(Field("com_offset", "m, centre of mass below the ball centre"), m.com_offset);
+  v(Field("inertia_transverse", "kg m^2, A about G"), m.inertia_transverse);
+  v(Field("inertia_axial", "kg m^2, C about G"), m.inertia_axial);
+}
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, WorkCounters>> visit(R& w, V& v) {
+  v(Field("steps"), w.steps);
+  v(Field("rhs_evaluations"), w.rhs_evaluations);
+  v(Field("solver_iterations"), w.solver_iterations);
+  v(Field("wall_seconds", "s"), w.wall_seconds);
+  v(Field("cpu_seconds", "s"), w.cpu_seconds);
+}
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, RunRecord::LedgerPoint>> visit(R& l, V& v) {
+  v(Field("time", "s"), l.time);
+  v(Field("energy", "J: E at that sample"), l.energy);
+  v(Field("normal_work", "J"), l.normal_work);
+  v(Field("friction_work", "J"), l.friction_work);
+  v(Field("drilling_work", "J"), l.drilling_work);
+  v(Field("impact_energy", "J"), l.impact_energy);
+  v(Field("numerical_energy", "J"), l.numerical_energy);
+}
+
+// summary.json's fields but "format" (to_json writes it, from_json checks it), in the order
+// from_json reads them (a record with several faults names the first).
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, RunRecord>> visit(R& r, V& v) {
+  v(Field("scene", "scene name"), r.scene_name);
+  v(Field("scene_file", "the scene file as given"), r.scene_file);
+  v(Field("scene_hash", "FNV-1a 64 of the file's bytes and the overrides, 16 hex digits"), r.scene_hash);
+  v(Field("scene_spec", "every field of the scene as run (overrides applied)").since(), r.scene_spec);
+  v(Field("engine"), r.engine);
+  v(Field("engine_version"), r.engine_version);
+  v(Field("status", "how the run ended").one_of(run_status_names()), r.status);
+  v(Field("status_time", "s: when the status left ok (0 for ok)"), r.status_time);
+  v(Field("status_detail"), r.status_detail);
+  v(Field("inversion_time", "s: first 'inversion' event (tilt crosses 90 deg); null: none"), r.inversion_time);
+  v(Field("stem_contact_time", "s: first 'stem_contact' event; null: none"), r.stem_contact_time);
+  v(Field("samples", "rows of trajectory.csv").minimum(0), r.samples);
+  v(Field("final_time", "s: time of the last sample"), r.final_time);
+  v(Field("final_tilt", "rad: tilt of the symmetry axis from the vertical at the last sample"), r.final_tilt);
+  v(Field("energy_initial", "J"), r.energy_initial);
+  v(Field("energy_final", "J"), r.energy_final);
+  v(Field("jellett_initial", "kg m^3/s: Jellett's integral J = L_G . R_C at the first sample"), r.jellett_initial);
+  v(Field("jellett_max_relative_drift",
+          "largest relative drift of Jellett's integral within a run of samples on one surface"),
+    r.jellett_max_relative_drift);
+  v(Field("jellett_drift_ball", "the same on the ball only; null: no run on the ball"), r.jellett_drift_ball);
+  v(Field("jellett_drift_stem", "the same on the stem only; null: no run on the stem"), r.jellett_drift_stem);
+  v(Field("min_normal_force", "N"), r.min_normal_force);
+  v(Field("friction_work",
+          "J: the work of the friction forces on the top over the run (sum over steps and contacts of F_t . v_C dt; "
+          "the reference's own integral of its tangential force's power); null: not reported (records written before it)")
+        .since(),
+    r.friction_work);
+  v(Field("normal_work",
+          "J: energy ledger, the work of the normal forces on the top (sum over steps and contacts of F_n v_C.z dt); "
+          "null: not available")
+        .since(),
+    r.normal_work);
+  v(Field("drilling_work",
+          "J: energy ledger, the work of the drilling and rolling torques on the top; null: not available (engines "
+          "report no contact torques)")
+        .since(),
+    r.drilling_work);
+  v(Field("impact_energy",
+          "J: energy ledger, the energy removed at impacts (the reference's impact, hold and projection events); null: "
+          "not available (an engine's impacts are inside its normal work)")
+        .since(),
+    r.impact_energy);
+  v(Field("elastic_energy_max",
+          "J: energy ledger, the largest elastic energy stored in a soft contact (the engine's contact law's potential "
+          "of the penetration); null: not available")
+        .since(),
+    r.elastic_energy_max);
+  v(Field("numerical_energy_max",
+          "J: energy ledger, the largest |N(t)| of the numerical energy N = E - E0 - (normal + friction + drilling "
+          "work) + impact_energy over the samples (null terms as 0); null: no ledger")
+        .since(),
+    r.numerical_energy_max);
+  v(Field("numerical_energy_final", "J: energy ledger, N at the last sample; null: no ledger").since(),
+    r.numerical_energy_final);
+  v(Field("ledger_not_available",
+          "the ledger's terms the simulator could not give (absent in records written before it)")
+        .since()
+        .one_of(ledger_term_names()),
+    r.ledger_not_available);
+  v(Field("ledger_at_inversion",
+          "the energy ledger at the first sample at or after the run's first inversion event (J; time in s); null: no "
+          "inversion or no ledger; absent in records written before it")
+        .since(),
+    r.ledger_at_inversion);
+  v(Field("mass_properties"), r.mass);
+  v(Field("inversion_possible", "1 - alpha < A/C < 1 + alpha"), r.inversion_possible);
+  v(Field("work"), r.work);
+  v(Field("events"), r.events);
+  v(Field("settings", "every setting that decides accuracy, as used"), r.settings);
+  v(Field("notes"), r.notes);
+  v(Field("provenance", "Where and with what build the record was made"), r.provenance);
+}
+
 // The ledger's numbers at one sample, from the simulator's totals and the sample's energy
 // (Observation's ledger fields; e0: the run's first energy).
 void fill_ledger(Observation& o, const EnergyLedgerTotals& l, double e0);
@@ -135,10 +261,6 @@ nlohmann::json to_json(const RunRecord& r);
 // summary without "format" (written before it existed) is read as tippe-run-1.
 RunRecord from_json(const nlohmann::json& j);
 
-// An integer field of a record (counts of samples, steps, events): a JSON integer within the
-// range of long long. Throws nlohmann::json::exception for a missing field or any other value;
-// json::get<long long> would convert a float such as 1e300 with undefined behaviour.
-long long json_integer(const nlohmann::json& j, const char* key);
 
 // The trajectory columns, in file order.
 const std::vector<std::string>& trajectory_columns();

@@ -1,0 +1,176 @@
+// Each record's one field list (`visit`, records/fields.h): every field it lists is written, read back, described by the committed schema and, for a comparison's numbers, in the metric table.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "records/comparison.h"
+#include "records/fields.h"
+#include "records/metric_bounds.h"
+#include "records/record_schemas.h"
+#include "records/records.h"
+#include "support/files.h"
+
+namespace {
+
+using namespace tippe;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+// Sets every field a `visit` lists to a value no other field has (strings among their choices),
+// so that a field written under another's key, or read into another, shows in a round trip.
+class Filler {
+ public:
+  void operator()(const Field& f, std::string& v) {
+    v = f.choices() ? f.choices()->at(n_++ % f.choices()->size()) : "text " + std::to_string(n_++);
+  }
+  void operator()(const Field&, double& v) { v = 0.5 + n_++; }
+  void operator()(const Field&, std::optional<double>& v) { v = 0.25 + n_++; }
+  void operator()(const Field&, long long& v) { v = n_++; }
+  void operator()(const Field&, std::optional<long long>& v) { v = n_++; }
+  void operator()(const Field&, bool& v) { v = !v; }
+  void operator()(const Field& f, std::vector<std::string>& v) {
+    v = {f.choices() ? f.choices()->at(n_++ % f.choices()->size()) : "item " + std::to_string(n_++)};
+  }
+  void operator()(const Field&, json& v) { v = {{"key", n_++}}; }
+  void operator()(const Field&, SettingsList& v) { v = {{"setting", std::to_string(n_++)}}; }
+  template <class T, std::enable_if_t<has_visit<T>::value, int> = 0>
+  void operator()(const Field&, T& part) { visit(part, *this); }
+  template <class T>
+  void operator()(const Field&, std::optional<T>& part) {
+    part.emplace();
+    visit(*part, *this);
+  }
+  template <class T>
+  void operator()(const Field&, std::vector<T>& parts) {
+    parts.resize(2);
+    for (T& p : parts) visit(p, *this);
+  }
+
+ private:
+  int n_ = 1;
+};
+
+template <class T>
+T filled() {
+  T r{};
+  Filler f;
+  visit(r, f);
+  return r;
+}
+
+std::set<std::string> keys_of(const json& j) {
+  std::set<std::string> k;
+  for (const auto& [key, v] : j.items()) k.insert(key);
+  return k;
+}
+
+template <class T>
+std::set<std::string> visited_keys() {
+  std::set<std::string> k;
+  for (const FieldInfo& f : field_list<T>()) EXPECT_TRUE(k.insert(f.key).second) << f.key << " listed twice";
+  return k;
+}
+
+json committed_schema(const std::string& name) {
+  return json::parse(slurp(fs::path(TIPPE_SOURCE_DIR) / "schemas" / (name + ".schema.json")));
+}
+
+// ---- the run summary ------------------------------------------------------------------------------
+
+TEST(RecordFields, RunSummaryWritesExactlyItsVisitedFieldsAndReadsEveryOneBack) {
+  const RunRecord r = filled<RunRecord>();
+  const json j = to_json(r);
+  std::set<std::string> expected = visited_keys<RunRecord>();
+  expected.insert("format");
+  EXPECT_EQ(keys_of(j), expected);
+  // Distinct values: a field read into another, or not read, changes the JSON written again.
+  EXPECT_EQ(to_json(from_json(json::parse(j.dump()))), j);
+  EXPECT_EQ(from_json(j).samples, r.samples);
+  EXPECT_EQ(from_json(j).ledger_at_inversion->numerical_energy, r.ledger_at_inversion->numerical_energy);
+}
+
+TEST(RecordFields, RunSummaryFieldsSinceAFormatChangeReadAsTheirDefaultWhenAbsent) {
+  json j = to_json(filled<RunRecord>());
+  const RunRecord defaults{};
+  const json written_defaults = to_json(defaults);
+  for (const FieldInfo& f : field_list<RunRecord>()) {
+    json without = j;
+    without.erase(f.key);
+    bool since = false;
+    try {
+      const json back = to_json(from_json(without));
+      since = true;
+      EXPECT_EQ(back.at(f.key), written_defaults.at(f.key)) << f.key << " absent does not read as its default";
+    } catch (const json::exception&) {
+    }
+    const json schema = committed_schema("run-summary").at("$defs").at("summary");
+    const auto& req = schema.at("required");
+    EXPECT_EQ(std::find(req.begin(), req.end(), f.key) == req.end(), since)
+        << f.key << ": the schema's required list and the reader disagree";
+  }
+}
+
+// ---- the comparison's metrics ---------------------------------------------------------------------
+
+TEST(RecordFields, MetricsWriteExactlyTheirVisitedFieldsAndReadEveryOneBack) {
+  const Metrics m = filled<Metrics>();
+  const json j = to_json(m);
+  EXPECT_EQ(keys_of(j), visited_keys<Metrics>());
+  EXPECT_EQ(to_json(metrics_from_json(json::parse(j.dump()))), j);
+}
+
+// A number added to Metrics' `visit` is in the metric table unless the visit says why not.
+TEST(RecordFields, EveryBoundedNumberOfMetricsIsInTheMetricTable) {
+  const Metrics m = filled<Metrics>();
+  const json j = to_json(m);
+  size_t bounded = 0;
+  for (const FieldInfo& f : field_list<Metrics>()) {
+    const GateMetric* g = find_gate_metric(f.key);
+    if (!f.bounded) {
+      EXPECT_EQ(g, nullptr) << f.key;
+      continue;
+    }
+    ++bounded;
+    ASSERT_NE(g, nullptr) << f.key << " is a bounded number of Metrics but not in the metric table";
+    ASSERT_TRUE(g->get(m).has_value()) << f.key;
+    EXPECT_EQ(*g->get(m), j.at(f.key).get<double>()) << f.key;
+    EXPECT_EQ(std::string(g->unit), f.doc) << f.key;
+  }
+  EXPECT_EQ(gate_metrics().size(), bounded);
+}
+
+// ---- the schemas ------------------------------------------------------------------------------------
+
+TEST(RecordFields, CommittedSchemasAreTheGeneratedOnes) {
+  for (const std::string& name : generated_schema_names()) {
+    const fs::path file = fs::path(TIPPE_SOURCE_DIR) / "schemas" / (name + ".schema.json");
+    EXPECT_EQ(slurp(file), record_schema_text(name))
+        << file << " differs from the record's field list; regenerate it:\n"
+        << "  ./build/tippe info --schema " << name << " > schemas/" << name << ".schema.json";
+  }
+}
+
+// What the comparison above rests on: every visited field is a property of the schema, with the
+// type its C++ type gives, so a field added to a `visit` is in the committed schema.
+TEST(RecordFields, EveryVisitedFieldIsAPropertyOfItsSchema) {
+  const json summary = json::parse(record_schema_text("run-summary")).at("$defs").at("summary").at("properties");
+  for (const FieldInfo& f : field_list<RunRecord>()) EXPECT_TRUE(summary.contains(f.key)) << f.key;
+  const json metrics = json::parse(record_schema_text("comparison")).at("$defs").at("metrics").at("properties");
+  for (const FieldInfo& f : field_list<Metrics>()) {
+    ASSERT_TRUE(metrics.contains(f.key)) << f.key;
+    const std::string type = metrics.at(f.key).value("type", json()).dump();
+    if (f.number) {
+      EXPECT_TRUE(type.find("number") != std::string::npos || type.find("integer") != std::string::npos) << f.key;
+    }
+  }
+  EXPECT_EQ(summary.at("samples").at("type"), "integer");
+  EXPECT_EQ(summary.at("ledger_at_inversion").at("type"), json({"object", "null"}));
+  EXPECT_EQ(metrics.at("events_missing").at("minimum"), 0);
+}
+
+}  // namespace
