@@ -7,6 +7,7 @@
 #include "mass_properties.h"
 #include "registry.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "simulator.h"
 
 namespace tippe::cli {

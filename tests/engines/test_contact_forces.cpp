@@ -8,8 +8,10 @@
 
 #include "bench_friction.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "registry.h"
 #include "simulator.h"
+#include "support/fixtures.h"
 
 namespace tippe {
 namespace {

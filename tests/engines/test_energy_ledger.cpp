@@ -10,10 +10,12 @@
 
 #include "../analytic/reference_model.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "measure/run.h"
 #include "records/trajectory.h"
 #include "registry.h"
 #include "simulator.h"
+#include "support/fixtures.h"
 
 namespace tippe {
 namespace {

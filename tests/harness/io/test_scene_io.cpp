@@ -14,6 +14,7 @@
 #include "records/records.h"
 #include "measure/run.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "support/files.h"
 #include "support/fixtures.h"
 
