@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "io/scene_io.h"
+#include "registry.h"
 #include "scene/resolve.h"
 #include "support/files.h"
 #include "support/fixtures.h"
@@ -45,6 +46,28 @@ TEST(SceneResolve, AppliesTheReferencesSettings) {
   const SceneFile raw = parse_scene_file(text, "base.toml");
   EXPECT_EQ(raw.scene.run.rtol, 1e-10);  // RunSpec's default: the table is not read yet
   EXPECT_EQ(resolve_scene(raw).run.rtol, 1e-8);
+}
+
+TEST(SceneIo, ReferenceSettingsInEnginesAnalyticAndTheirOlderSpelling) {
+  // [engines.analytic] is where the reference's settings live; [run]'s older keys are still read
+  // and listed (the reference notes them as deprecated); a key in both is refused (bad_scenes).
+  TempDir dir{"tippe-test"};
+  const std::string path =
+      dir.write("ref.toml", edit(edit(kBase, "rtol = 1e-10\n", ""), "atol = 1e-12\n", "") +
+                                "[engines.analytic]\nrtol = 1e-8\nmethod = \"dopri5\"\nself_check = false\n");
+  const Scene s = load_scene(path);
+  EXPECT_EQ(s.run.rtol, 1e-8);
+  EXPECT_EQ(s.run.method, "dopri5");
+  EXPECT_FALSE(s.run.self_check);
+  EXPECT_TRUE(make_simulator("analytic", s)->notes().empty());
+  const Scene old = load_scene(dir.write("old.toml", kBase));
+  ASSERT_FALSE(old.run.alias_keys.empty());
+  const auto notes = make_simulator("analytic", old)->notes();
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("run.rtol"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("deprecated"), std::string::npos) << notes[0];
+  const Scene fresh = load_scene(dir.write("new.toml", edit(edit(kBase, "rtol = 1e-10\n", ""), "atol = 1e-12\n", "")));
+  EXPECT_TRUE(fresh.run.alias_keys.empty());
 }
 
 TEST(SceneResolve, ContentHashFormulaIsTheOnePublishedRecordsKeyOn) {
