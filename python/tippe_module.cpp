@@ -27,6 +27,7 @@
 #include "io/output_dir.h"
 #include "io/progress.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "library/verbs.h"
 #include "measure/run.h"
 #include "records/sweep_record.h"

@@ -40,4 +40,11 @@ BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSp
 // engine's own contact is frictionless under these laws, so they are the friction of the step).
 void add_bench_friction(ContactReport& r, const BenchFrictionForces& f);
 
+// The engine's contacts r with the bench's friction f of the step added: the contacts of the
+// step as the checks, the work and contact_forces() read them (add_bench_friction on a copy).
+inline ContactReport with_bench_friction(ContactReport r, const BenchFrictionForces& f) {
+  add_bench_friction(r, f);
+  return r;
+}
+
 }  // namespace tippe

@@ -6,10 +6,20 @@
 // list. Adding an engine: its folder engines/NAME/, tippe_add_engine(NAME ...) in
 // engines/CMakeLists.txt, one line here and one row in the conformance suite
 // (tests/engines/test_conformance.cpp).
-// No include guard: expanded once per TIPPE_ENGINE definition.
+// An engine's setting whose value names a file, relative to the scene file, is one line
+// TIPPE_ENGINE_FILE(NAME, KEY, WHAT) (WHAT as messages name the file): the scene's resolve step
+// (harness/scene/resolve.h) reads it with the scene and its bytes join the scene's content hash.
+// Declared here rather than in the engine's module, so that a build without the engine reads and
+// hashes a scene as the full build does.
+// No include guard: expanded once per TIPPE_ENGINE or TIPPE_ENGINE_FILE definition.
+#ifdef TIPPE_ENGINE
 TIPPE_ENGINE(bullet)
 TIPPE_ENGINE(ode)
 TIPPE_ENGINE(mujoco)
 TIPPE_ENGINE(dart)
 TIPPE_ENGINE(simbody)
 TIPPE_ENGINE(siconos)
+#endif
+#ifdef TIPPE_ENGINE_FILE
+TIPPE_ENGINE_FILE(mujoco, model, "an MJCF file")
+#endif

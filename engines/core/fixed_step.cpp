@@ -27,9 +27,7 @@ void FixedStepSimulator::start(double dt) {
 Observation FixedStepSimulator::observe() const { return observe_with_contacts(body_, engine_state(), engine_contacts()); }
 
 EngineContactForces FixedStepSimulator::contact_forces() const {
-  ContactReport r = engine_contacts();
-  add_bench_friction(r, bench_applied_);
-  return tippe::contact_forces(r);
+  return tippe::contact_forces(contacts_with_bench_friction());
 }
 
 void FixedStepSimulator::set_state(const BodyState& x) {
@@ -104,9 +102,7 @@ void FixedStepSimulator::step_once() {
   const std::string failure = engine_failure();
   if (!failure.empty()) return checks_.fail(RunStatus::Failed, t, failure);
   // The contacts with the bench's friction of the step, for its work (the events read the flags).
-  ContactReport c = engine_contacts();
-  add_bench_friction(c, bench_applied_);
-  if (!checks_.after_step(t, engine_state(), c)) return;
+  if (!checks_.after_step(t, engine_state(), contacts_with_bench_friction())) return;
   const std::string limit = engine_limit_hit();
   if (!limit.empty()) return checks_.fail(RunStatus::Clamped, t, limit);
 }

@@ -87,6 +87,8 @@ class FixedStepSimulator : public CheckedSimulator {
 
  private:
   void step_once();
+  // The engine's contacts plus the bench's friction of the last step (viscous, gliding).
+  ContactReport contacts_with_bench_friction() const { return with_bench_friction(engine_contacts(), bench_applied_); }
 
   const EngineInfo& info_;
   Scene scene_;

@@ -190,6 +190,15 @@ bool engine_loaded(const std::string& name) {
   return s && s->info.load(std::memory_order_acquire) != nullptr;
 }
 
+const std::vector<EngineFileSetting>& engine_file_settings() {
+  static const std::vector<EngineFileSetting> all = {
+#define TIPPE_ENGINE_FILE(engine, key, what) {#engine, #key, what},
+#include "engine_list.h"
+#undef TIPPE_ENGINE_FILE
+  };
+  return all;
+}
+
 std::string engine_list_text(const std::vector<std::string>& names) {
   std::string s;
   for (size_t i = 0; i < names.size(); ++i) s += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];

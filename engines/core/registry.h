@@ -96,6 +96,17 @@ const EngineInfo& analytic_engine_info();
     return &::tippe::name##_engine_info();                                                               \
   }
 
+// A setting of an engine whose value names a file relative to the scene file (engine_list.h's
+// TIPPE_ENGINE_FILE lines): the scene's resolve step reads the file with the scene, puts its
+// normalised path in the setting and hashes its bytes under "engines.ENGINE.KEY".
+struct EngineFileSetting {
+  std::string engine;
+  std::string key;
+  std::string what;  // the file as messages name it: "an MJCF file"
+};
+// Every engine's file settings, in engine_list.h's order; known in every build, loads nothing.
+const std::vector<EngineFileSetting>& engine_file_settings();
+
 // An engine's module could not be loaded (not found, or dlopen/dlsym failed): the message names
 // the engine, the module and the paths tried or the loader's own error.
 class EngineLoadError : public std::runtime_error {

@@ -491,36 +491,6 @@ const EngineInfo& mujoco_engine_info() {
   return info;
 }
 
-std::string mujoco_mjcf(const Scene& scene) {
-  const MujocoSettings s = read_checked_settings(scene);
-  if (!s.model.empty())
-    throw std::invalid_argument("engines.mujoco.model: the scene runs the user's model " + s.model +
-                                "; that file is its MuJoCo model (export-mjcf writes the bench's own)");
-  return build_mjcf(scene, s);
-}
-
-std::vector<std::string> mujoco_mjcf_missing(const Scene& scene) {
-  std::vector<std::string> out;
-  const ContactSpec& c = scene.contact;
-  if (c.friction == FrictionLaw::Viscous && c.k > 0) {
-    std::ostringstream k;
-    k.imbue(std::locale::classic());
-    k << c.k;
-    out.push_back("the viscous friction F_t = -k v_C (k = " + k.str() +
-                  ") that the bench applies each step as an external force at every contact: the model's contacts "
-                  "are frictionless, so in plain MuJoCo the top only spins");
-  }
-  if (c.friction == FrictionLaw::Gliding && c.mu > 0) {
-    std::ostringstream mu;
-    mu.imbue(std::locale::classic());
-    mu << c.mu;
-    out.push_back("the gliding friction F_t = -mu F_n v_C (mu = " + mu.str() +
-                  " s/m) that the bench applies each step as an external force at every contact, with the engine's "
-                  "previous normal force: the model's contacts are frictionless, so in plain MuJoCo the top only spins");
-  }
-  return out;
-}
-
 }  // namespace tippe
 
 // The module's one exported symbol, tippe_engine_mujoco: the registry's way in (registry.h).

@@ -334,8 +334,7 @@ void SiconosSimulator::step_once() {
   }
   if (sim_->getNewtonNbIterations() >= static_cast<unsigned>(settings_.newton_max_iterations)) ++newton_unconverged_;
   const double t = time();
-  report_ = read_contacts();
-  add_bench_friction(report_, bench_applied_);
+  report_ = with_bench_friction(read_contacts(), bench_applied_);
   checks_.after_step(t, read_state(), report_);
 }
 

@@ -12,6 +12,7 @@
 #include "gating/gate.h"
 #include "io/files.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "io/text.h"
 #include "measure/classify.h"
 #include "measure/metrics.h"

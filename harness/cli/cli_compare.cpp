@@ -13,6 +13,7 @@
 #include "report/report.h"
 #include "io/files.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "records/sweep_record.h"
 
 namespace tippe::cli {

@@ -7,6 +7,7 @@
 #include "mujoco_api.h"
 #include "records/records.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace tippe::cli {
 

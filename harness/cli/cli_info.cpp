@@ -9,6 +9,7 @@
 #include "io/scene_io.h"
 #include "records/comparison.h"
 #include "records/record_schemas.h"
+#include "scene/resolve.h"
 #include "simulator.h"
 
 namespace tippe::cli {

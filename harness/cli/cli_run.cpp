@@ -11,6 +11,7 @@
 #include "records/records.h"
 #include "measure/run.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace tippe::cli {
 

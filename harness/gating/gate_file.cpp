@@ -22,6 +22,7 @@
 
 #include "records/records.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "io/toml_reader.h"
 
 namespace tippe {

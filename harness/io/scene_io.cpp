@@ -1,9 +1,8 @@
-// Reading scene files: TOML -> Scene with every key checked, and command-line overrides.
+// Reading scene files: TOML -> Scene with every key checked (its [engines.*] tables raw), and command-line overrides.
 #include "io/scene_io.h"
 #include "io/hash.h"
 #include "io/text.h"
 
-#include "registry.h"
 #include "io/toml_reader.h"
 
 #include <algorithm>
@@ -21,7 +20,6 @@
 
 #include <toml++/toml.h>
 
-#include "adapters.h"
 #include "mass_properties.h"
 #include "io/files.h"
 
@@ -44,17 +42,6 @@ constexpr double kMinRtol = 1e-15;
 constexpr double kMaxRtol = 1e-2;
 
 
-
-std::string fnv1a64_hex(const std::string& bytes, const std::vector<std::string>& overrides) {
-  Fnv1a64 h;
-  h.add(bytes);
-  // A separator keeps {"a", "bc"} and {"ab", "c"} apart.
-  for (const auto& o : overrides) {
-    h.add(static_cast<unsigned char>(0));
-    h.add(o);
-  }
-  return h.hex();
-}
 
 bool is_bare_key(const std::string& s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
@@ -394,102 +381,59 @@ class Interpreter : public TomlReader {
       auto& dst = s.engines[std::string(name.str())];
       for (auto&& [k, v] : *et) dst[std::string(k.str())] = to_setting(v, prefix + "." + std::string(k.str()));
     }
-    resolve_mujoco_model(s);
-    try {
-      validate_engine_settings(s);
-      if (reference_engine().adopt) reference_engine().adopt(s);
-    } catch (const std::invalid_argument& e) {
-      // The shipped scenes give the reference's settings in [engines.analytic], so an override
-      // in the older spelling (--set run.rtol=...) meets them there: say which spelling to use.
-      std::string hint;
-      const std::string table = "engines." + reference_engine().name + ".";
-      for (const std::string& k : s.run.alias_keys)
-        if (overridden("run." + k) && std::string(e.what()).rfind(table + k + ":", 0) == 0)
-          hint = "; run." + k + " was set with --set: set " + table + k + " instead";
-      throw SceneError(file() + ": " + e.what() + hint);
-    } catch (const EngineLoadError& e) {
-      // A table whose engine's module cannot be loaded cannot be checked: the scene is refused
-      // with the loader's reason (SceneError stays the only exception a scene's reading throws).
-      throw SceneError(file() + ": " + e.what());
-    }
   }
-
-  // engines.mujoco.model names the user's own MJCF, relative to the scene file: resolved here,
-  // read once (its bytes join the scene's content hash, so a changed model is a changed scene)
-  // and checked by validate_engine_settings (MuJoCo compiles it).
-  void resolve_mujoco_model(Scene& s) const {
-    auto engine = s.engines.find("mujoco");
-    if (engine == s.engines.end()) return;
-    auto it = engine->second.find("model");
-    if (it == engine->second.end()) return;
-    const auto* path = std::get_if<std::string>(&it->second);
-    if (!path) fail("engines.mujoco.model", "expected a string (a path to an MJCF file, relative to the scene file)");
-    if (path->empty()) fail("engines.mujoco.model", "is empty (expected a path to an MJCF file)");
-    std::filesystem::path p(*path);
-    if (p.is_relative()) p = std::filesystem::path(file()).parent_path() / p;
-    std::error_code ec;
-    if (std::filesystem::is_directory(p, ec)) fail("engines.mujoco.model", p.string() + ": is a directory");
-    try {
-      model_bytes_ = read_file_text(p.string(), kMaxInputFileBytes);
-    } catch (const std::runtime_error& e) {
-      fail("engines.mujoco.model", e.what());
-    }
-    it->second = p.lexically_normal().string();
-    has_model_ = true;
-  }
-
- public:
-  bool has_model() const { return has_model_; }
-  const std::string& model_bytes() const { return model_bytes_; }
-
- private:
-  mutable std::string model_bytes_;
-  mutable bool has_model_ = false;
 };
 
 }  // namespace
 
-Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+SceneFile read_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
   std::string text;
   try {
     text = read_file_text(path, kMaxInputFileBytes);
   } catch (const std::runtime_error& e) {
     throw SceneError(e.what());
   }
-  return parse_scene_text(text, path, overrides);
+  return parse_scene_file(text, path, overrides);
 }
 
-Scene parse_scene_text(const std::string& text, const std::string& file_label,
-                       const std::vector<std::string>& overrides) {
+SceneFile parse_scene_file(const std::string& text, const std::string& file_label,
+                           const std::vector<std::string>& overrides) {
   // The label is the scene's source_file in every JSON record: checked before any work is done.
   if (!is_valid_utf8(file_label)) throw SceneError(file_label + ": cannot read: the path is not valid UTF-8");
   toml::table root = parse_toml(text, file_label);
 
-  std::set<std::string> overridden;
-  for (const auto& o : overrides) overridden.insert(trim(o.substr(0, o.find('='))));
-  Interpreter interp(file_label, overridden);
+  Interpreter interp(file_label, overridden_keys(overrides));
   for (const auto& o : overrides) interp.apply_override(root, o);
 
-  Scene s = interp.interpret(root, std::filesystem::path(file_label).stem().string());
-  s.source_file = file_label;
-  // A scene that runs a user's MJCF hashes its bytes too: a changed model is a changed scene.
-  s.content_hash = interp.has_model() ? fnv1a64_hex(text + std::string(1, '\0') + "engines.mujoco.model" +
-                                                         std::string(1, '\0') + interp.model_bytes(),
-                                                     overrides)
-                                      : fnv1a64_hex(text, overrides);
-  return s;
+  SceneFile f{interp.interpret(root, std::filesystem::path(file_label).stem().string()), text, overrides};
+  f.scene.source_file = file_label;
+  f.scene.content_hash = scene_content_hash(text, overrides);
+  return f;
 }
 
-std::vector<std::filesystem::path> scene_input_files(const Scene& scene) {
-  std::vector<std::filesystem::path> files;
-  if (!scene.source_file.empty()) files.emplace_back(scene.source_file);
-  const auto engine = scene.engines.find("mujoco");
-  if (engine != scene.engines.end()) {
-    const auto it = engine->second.find("model");
-    if (it != engine->second.end())
-      if (const auto* path = std::get_if<std::string>(&it->second)) files.emplace_back(*path);
+std::string scene_content_hash(const std::string& text, const std::vector<std::string>& overrides,
+                               const std::vector<std::pair<std::string, std::string>>& inputs) {
+  Fnv1a64 h;
+  h.add(text);
+  // Each further input under its key, a separator on either side.
+  for (const auto& [key, bytes] : inputs) {
+    h.add(static_cast<unsigned char>(0));
+    h.add(key);
+    h.add(static_cast<unsigned char>(0));
+    h.add(bytes);
   }
-  return files;
+  // A separator keeps {"a", "bc"} and {"ab", "c"} apart.
+  for (const auto& o : overrides) {
+    h.add(static_cast<unsigned char>(0));
+    h.add(o);
+  }
+  return h.hex();
+}
+
+std::set<std::string> overridden_keys(const std::vector<std::string>& overrides) {
+  std::set<std::string> keys;
+  for (const auto& o : overrides) keys.insert(trim(o.substr(0, o.find('='))));
+  return keys;
 }
 
 }  // namespace tippe

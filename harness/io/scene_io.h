@@ -1,9 +1,11 @@
-// Scene files: TOML -> Scene with every key checked, command-line overrides, and Scene -> JSON.
+// Scene files: TOML -> Scene with every key checked (its [engines.*] tables raw), command-line overrides, and Scene -> JSON.
 #pragma once
 
 #include <stdexcept>
 #include <filesystem>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -14,7 +16,7 @@
 namespace tippe {
 
 // Invalid scene input. The message is always "FILE: KEY: reason" with KEY dotted
-// ("body.stem_radius", "engines.mujoco.timestep", "--set" for a malformed override), except
+// ("body.stem_radius", "engines.NAME.KEY", "--set" for a malformed override), except
 // for TOML syntax errors, which read "FILE:LINE:COL: reason", and an unreadable file
 // ("FILE: cannot read: reason"). A value outside its range reads
 // "FILE: KEY: VALUE is out of range (expected RANGE)"; a wrong type names the value too
@@ -22,6 +24,16 @@ namespace tippe {
 class SceneError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+// A scene as its file says it: every key checked but the [engines.NAME] tables, which are only
+// copied (bool, integer -> long long, float -> double, string, array of numbers -> vector<double>).
+// What the tables mean (each engine's settings, the reference's, an engine's files) is the
+// resolve step's, one layer up (scene/resolve.h: load_scene), the only way a run gets a Scene.
+struct SceneFile {
+  Scene scene;                         // engines raw; content_hash = scene_content_hash(text, overrides)
+  std::string text;                    // the file's bytes
+  std::vector<std::string> overrides;  // as given, in order
 };
 
 // Reads a scene file. `overrides` are "KEY=VALUE" strings (KEY dotted, VALUE a TOML value or,
@@ -56,27 +68,26 @@ class SceneError : public std::runtime_error {
 //    drilling > 0.
 //  - initial: rolling derives the velocity of G, so initial.velocity is rejected with it;
 //    omega_along_contact takes its magnitude from spin and so cannot be combined with omega.
-//  - [engines.NAME] tables are copied into Scene::engines (bool, integer -> long long,
-//    float -> double, string, array of numbers -> vector<double>) and checked with
-//    validate_engine_settings. engines.mujoco.model (a user's MJCF) is resolved relative to the
-//    scene file's directory and must be readable (at most kMaxInputFileBytes).
+//  - [engines.NAME] tables: each a table, each value one of the types above.
 // A path that is not valid UTF-8, and a --set value that is not valid UTF-8 and not a TOML value,
 // are rejected: records are JSON.
-// Scene::content_hash is FNV-1a 64 (16 hex digits) over the file's bytes, the overrides and the
-// bytes of engines.mujoco.model when given;
-// Scene::source_file is `path` as given.
-Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+// SceneFile::scene.source_file is `path` as given.
+SceneFile read_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
 
-// What load_scene does once it has the file's bytes: `text` is parsed and checked as above,
+// What read_scene_file does once it has the file's bytes: `text` is parsed and checked as above,
 // `file_label` takes the place of the path in messages, the default name (its stem) and
-// Scene::source_file. Touches no file; SceneError is the only exception it throws for any
-// input (the fuzz target tests/fuzz/fuzz_scene.cpp holds it to that).
-Scene parse_scene_text(const std::string& text, const std::string& file_label,
-                       const std::vector<std::string>& overrides = {});
+// Scene::source_file. Touches no file; SceneError is the only exception it throws for any input.
+SceneFile parse_scene_file(const std::string& text, const std::string& file_label,
+                           const std::vector<std::string>& overrides = {});
 
-// The files a scene was read from: its own, and engines.mujoco.model when given (an output must
-// never be written over, or around, one of them).
-std::vector<std::filesystem::path> scene_input_files(const Scene& scene);
+// A scene's content hash: FNV-1a 64 (16 hex digits) over the file's bytes, then for each further
+// input file (KEY, BYTES) '\0' KEY '\0' BYTES (so a changed input file is a changed scene), then
+// for each override '\0' OVERRIDE.
+std::string scene_content_hash(const std::string& text, const std::vector<std::string>& overrides,
+                               const std::vector<std::pair<std::string, std::string>>& inputs = {});
+
+// The dotted keys of "KEY=VALUE" overrides, trimmed (to tell which keys a --set gave).
+std::set<std::string> overridden_keys(const std::vector<std::string>& overrides);
 
 // Every field of a scene, its mass properties and engine tables, for run records.
 nlohmann::json scene_to_json(const Scene& scene);

@@ -17,7 +17,7 @@ const char* toml_type_name(toml::node_type t);
 std::string toml_value_text(const toml::node& n);
 
 // The most parts a dotted key or a table header may have. The deepest key of any file the bench
-// reads has 4 (setup[i].ladder.key's "engines.mujoco.solref"); toml++ recurses once per part,
+// reads has 4 (setup[i].ladder.key's "engines.NAME.KEY"); toml++ recurses once per part,
 // and a 100 KB file with a 50000-part key overflowed the stack (SIGSEGV).
 inline constexpr int kMaxTomlKeyParts = 64;
 

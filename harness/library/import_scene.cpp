@@ -8,6 +8,7 @@
 
 #include "io/output_dir.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "library/verbs.h"
 #include "mujoco_api.h"
 #include "settings.h"

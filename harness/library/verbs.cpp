@@ -9,6 +9,7 @@
 #include "io/interrupt.h"
 #include "io/output_dir.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "records/records.h"
 #include "records/sweep_record.h"
 #include "registry.h"

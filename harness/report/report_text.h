@@ -24,6 +24,15 @@ inline std::string str(const nlohmann::json& j, const char* key) {
   return j.contains(key) && j.at(key).is_string() ? j.at(key).get<std::string>() : std::string();
 }
 
+// A run's status for a table: "ok", or the status and when it ended.
+inline std::string status_text(const nlohmann::json& summary) {
+  const std::string status = str(summary, "status");
+  if (status == "ok") return status;
+  return status + " at t=" + fmt(num(summary, "status_time"), "%.6g");
+}
+// The time a run's record ends at.
+inline std::string run_time_text(const nlohmann::json& s) { return fmt(num(s, "final_time"), "%.6g"); }
+
 // The units of a scene's time and length, from what the comparison record holds (gravity and
 // the ball radius; records carry no unit names). g = 9.81 within 1 %: SI (s, m). g = 1 and R = 1:
 // the source's dimensionless top, time in units of sqrt(R/g) and length in R. Anything else:

@@ -16,6 +16,7 @@
 #include <stdexcept>
 
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "io/toml_reader.h"
 #include "registry.h"
 #include "sweep/sweep_search.h"

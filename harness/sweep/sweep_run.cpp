@@ -18,6 +18,7 @@
 #include "io/progress.h"
 #include "io/provenance.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "records/records.h"
 #include "sweep/sweep_detail.h"
 #include "sweep/sweep_progress.h"

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "io/toml_reader.h"
 
 namespace tippe {

@@ -10,6 +10,7 @@
 #include "contact_dynamics.h"
 #include "reference_model.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace tippe {
 namespace {

@@ -10,6 +10,7 @@
 #include "initial_state.h"
 #include "reference_model.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "support/fixtures.h"
 #include "support/reference_runs.h"
 

@@ -13,6 +13,7 @@
 #include "../analytic/initial_state.h"
 #include "../analytic/reference_model.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace tippe {
 namespace {

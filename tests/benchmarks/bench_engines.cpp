@@ -4,6 +4,7 @@
 #include "fixed_step.h"
 #include "registry.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace tippe {
 

@@ -13,6 +13,7 @@
 #include "initial_state.h"
 #include "observables.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "simulator.h"
 #include "support/fixtures.h"
 

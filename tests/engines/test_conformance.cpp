@@ -15,6 +15,7 @@
 #include "records/records.h"
 #include "measure/run.h"
 #include "registry.h"
+#include "support/fixtures.h"
 
 namespace tippe {
 namespace {
@@ -91,21 +92,6 @@ void check(const EngineRow& row, const char* what, double residual, double measu
 
 // ---- Scenes and helpers -----------------------------------------------------------------------
 
-// The dimensionless body of the source (REFERENCE_VALUES.md).
-Scene base_scene() {
-  Scene s;
-  s.name = "conformance";
-  s.gravity = 1.0;
-  s.body = {1.0, 0.25, 1.2, 0.9, 0.0, MassModel::Given};
-  s.mass = {1.0, 0.3, 0.4, 0.45};
-  s.contact.friction = FrictionLaw::Coulomb;
-  s.contact.mu = 0.3;
-  s.initial.tilt = 0.1;
-  s.initial.spin = 5.0;
-  s.run = {2.0, 0.01, 1e-10, 1e-12};
-  return s;
-}
-
 // A quaternion and its negative are the same attitude.
 double quat_distance(const Quat& a, const Quat& b) {
   return std::min((a.coeffs() - b.coeffs()).norm(), (a.coeffs() + b.coeffs()).norm());
@@ -144,7 +130,7 @@ class Conformance : public ::testing::TestWithParam<EngineRow> {
 // ---- The suite ------------------------------------------------------------------------------------
 
 TEST_P(Conformance, MassPropertiesReadBack) {
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   auto sim = make(s);
   const MassReadback h = sim->mass_properties();
   // Set explicitly from the scene, never computed from shapes: equal to round-off (1e-12).
@@ -156,7 +142,7 @@ TEST_P(Conformance, MassPropertiesReadBack) {
 }
 
 TEST_P(Conformance, RestingUprightStaysPut) {
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.initial.tilt = 0.0;
   s.initial.spin = 0.0;
   auto sim = make(s);
@@ -171,7 +157,7 @@ TEST_P(Conformance, RestingUprightStaysPut) {
 TEST_P(Conformance, RestingUprightStartsWithoutAcceleration) {
   // At rest upright on the ball, gravity and the normal force cancel: v and w stay 0. A finite
   // difference over the first 1e-3 time units measures each simulator's start-up transient.
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.initial.tilt = 0.0;
   s.initial.spin = 0.0;
   auto sim = make(s);
@@ -187,7 +173,7 @@ TEST_P(Conformance, RestingUprightStartsWithoutAcceleration) {
 TEST_P(Conformance, ContactPointAndNormalForce) {
   // Where the engine puts the contact (its own report) against the exact geometry, and the
   // weight it carries at rest: what the collision shapes and the contact solve make of the body.
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   const double R = s.body.sphere_radius, W = s.mass.mass * s.gravity;
   // The spinning tilted top under the viscous law (with Coulomb friction MuJoCo's contact hops
   // while the ball slips and reports no force at most samples), sampled over 0.1..0.3.
@@ -216,7 +202,7 @@ TEST_P(Conformance, ContactPointAndNormalForce) {
 }
 
 TEST_P(Conformance, FrictionlessUprightKeepsSpin) {
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.contact.friction = FrictionLaw::None;
   s.contact.mu = 0.0;
   s.initial.tilt = 0.0;
@@ -231,7 +217,7 @@ TEST_P(Conformance, FrictionlessUprightKeepsSpin) {
 TEST_P(Conformance, TorqueFreePrecession) {
   // Gravity off, the body in the air: w_B turns about e_Z at lambda = (C - A) w3 / A
   // (Euler's equations of an axisymmetric body).
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.gravity = 0.0;
   s.contact.flight = true;
   s.initial.height = 1.0;
@@ -251,7 +237,7 @@ TEST_P(Conformance, TorqueFreePrecession) {
 
 TEST_P(Conformance, SlidingBallStartsRolling) {
   // A uniform ball launched sliding at v0 rolls from t = 2 v0 / (7 mu g) at speed 5 v0 / 7.
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.contact.stem = false;
   s.mass = {1.0, 0.0, 0.4, 0.4};
   s.initial.tilt = 0.0;
@@ -276,7 +262,7 @@ TEST_P(Conformance, SlidingBallStartsRolling) {
 }
 
 TEST_P(Conformance, AdvanceToNowChangesNothing) {
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   auto sim = make(s);
   sim->advance_to(0.5);
   const BodyState a = sim->state();
@@ -295,7 +281,7 @@ TEST_P(Conformance, AdvanceToNowChangesNothing) {
 TEST_P(Conformance, StateRoundTripsThroughSetState) {
   // A state of the same motion at another time, written into a second simulator: state()
   // returns it (attitude up to the quaternion's sign), at the simulator's own time.
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   const double R = s.body.sphere_radius, v_scale = 5.0 * R;
   auto a = make(s);
   a->advance_to(0.2);
@@ -317,7 +303,7 @@ TEST_P(Conformance, StateRoundTripsThroughSetState) {
 TEST_P(Conformance, SetStateOfItsOwnStateResumesTheRun) {
   // set_state(state()) in the middle of a run: the run goes on as without it, up to what a
   // restart costs the simulator (the reference restarts its integrator; engines lose nothing).
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   const double R = s.body.sphere_radius, v_scale = 5.0 * R;
   auto a = make(s);
   auto b = make(s);
@@ -344,7 +330,7 @@ std::string run_bytes(const std::string& engine, const Scene& s, const std::stri
 }
 
 TEST_P(Conformance, Deterministic) {
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.run.duration = 1.0;
   const std::string dir = ::testing::TempDir(), name = row().engine;
   const std::string a = run_bytes(name, s, dir + "/det_a_" + name + ".csv");
@@ -354,7 +340,7 @@ TEST_P(Conformance, Deterministic) {
 }
 
 TEST_P(Conformance, NameAndVersionAreTheRegistrys) {
-  auto sim = make(base_scene());
+  auto sim = make(fixtures::dimensionless_scene());
   EXPECT_EQ(sim->engine(), row().engine);
   EXPECT_EQ(sim->version(), engine_info(row().engine).version);
 }
@@ -363,7 +349,7 @@ TEST_P(Conformance, TheRunReadsItsClocksNotTheSimulator) {
   // The run's wall and CPU time come from run_simulator, read at its loop's two ends; a
   // simulator leaves them 0 (a thread CPU clock read around each advance_to, a system call,
   // cost more than a sample).
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.run.duration = 0.5;
   auto sim = make(s);
   const RunRecord r = run_simulator(*sim, s, nullptr);
@@ -394,7 +380,7 @@ TEST(ConformanceTable, SharedKeysHaveOneBound) {
     const SettingsList defaults = engine_info(name).default_settings();
     if (std::none_of(defaults.begin(), defaults.end(), [](const auto& kv) { return kv.first == "timestep"; })) continue;
     ++engines_with_timestep;
-    Scene s = base_scene();
+    Scene s = fixtures::dimensionless_scene();
     s.engines[name]["timestep"] = 0.1;
     EXPECT_NO_THROW(engine_info(name).validate(s)) << name;
     s.engines[name]["timestep"] = 0.11;
@@ -426,7 +412,7 @@ Rhs reference_rhs(const Scene& s, const BodyState& x, bool stick) {
 }
 
 TEST(ReferenceRightHandSide, UprightAtRestHasZeroAccelerationAndWeightOnTheBall) {
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.initial.tilt = 0.0;
   s.initial.spin = 0.0;
   const BodyState x = scene_initial_state(s);
@@ -442,7 +428,7 @@ TEST(ReferenceRightHandSide, SpinningUprightTopOnlyTurns) {
   // no friction; w x I w = 0 for w along a principal axis. Hence dv/dt = 0, dw/dt = 0,
   // F_n = M g, and dq/dt = q (0, w_B) / 2 = (0, 0, 0, n / 2) for q = 1. With zero slip the
   // Coulomb contact sticks (the mode the reference settles into at this state).
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.initial.tilt = 0.0;
   const double n = s.initial.spin;
   const BodyState x = scene_initial_state(s);
@@ -458,7 +444,7 @@ TEST(ReferenceRightHandSide, TiltedSpinningTopSlidesAgainstItsSlip) {
   // v_G = 0, v_C = w x R_C with R_C = z_O e_Z - R e_z: v_C = -n R e_Z x e_z = (n R sin theta, 0, 0).
   // Coulomb sliding: F_t = -mu F_n v_C / |v_C|, so dv/dt = (-mu F_n / M, 0, F_n / M - g), and
   // the power balance at v_G = 0: d/dt (w.I w / 2) = n C dw_Z/dt = F_t . v_C = -mu F_n n R sin theta.
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   const double n = s.initial.spin, th = s.initial.tilt, R = s.body.sphere_radius, mu = s.contact.mu;
   const double M = s.mass.mass, C = s.mass.inertia_axial;
   const BodyState x = scene_initial_state(s);

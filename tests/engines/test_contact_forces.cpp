@@ -8,8 +8,10 @@
 
 #include "bench_friction.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "registry.h"
 #include "simulator.h"
+#include "support/fixtures.h"
 
 namespace tippe {
 namespace {
@@ -30,16 +32,10 @@ void PrintTo(const ForceRow& r, std::ostream* os) { *os << r.engine; }
 
 // The dimensionless body of the source (REFERENCE_VALUES.md): M = 1, g = 1, R = 1.
 Scene base_scene() {
-  Scene s;
+  Scene s = fixtures::dimensionless_scene();
   s.name = "contact_forces";
-  s.gravity = 1.0;
-  s.body = {1.0, 0.25, 1.2, 0.9, 0.0, MassModel::Given};
-  s.mass = {1.0, 0.3, 0.4, 0.45};
-  s.contact.friction = FrictionLaw::Coulomb;
-  s.contact.mu = 0.3;
   s.initial.tilt = 0.0;
   s.initial.spin = 0.0;
-  s.run = {2.0, 0.01, 1e-10, 1e-12};
   return s;
 }
 

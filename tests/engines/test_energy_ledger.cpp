@@ -10,10 +10,12 @@
 
 #include "../analytic/reference_model.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "measure/run.h"
 #include "records/trajectory.h"
 #include "registry.h"
 #include "simulator.h"
+#include "support/fixtures.h"
 
 namespace tippe {
 namespace {
@@ -104,27 +106,12 @@ std::vector<std::string> engines() {
   return out;
 }
 
-// The spinning tilted top of the dimensionless source body on a frictionless floor.
-Scene frictionless_top() {
-  Scene s;
-  s.name = "ledger_frictionless";
-  s.gravity = 1.0;
-  s.body = {1.0, 0.25, 1.2, 0.9, 0.0, MassModel::Given};
-  s.mass = {1.0, 0.3, 0.4, 0.45};
-  s.contact.friction = FrictionLaw::None;
-  s.contact.mu = 0.0;
-  s.initial.tilt = 0.1;
-  s.initial.spin = 5.0;
-  s.run = {2.0, 0.01, 1e-10, 1e-12};
-  return s;
-}
-
 TEST(EnergyLedger, FrictionlessRunsBookNoFrictionAndTheirEnergyErrorIsNumerical) {
   // No friction force, so no friction work; no torques and no impacts booked by an engine: the
   // energy error E - E0 is the normal force's work (the contact's store, its penetration
   // recovery) plus the numerical term, and the numerical term is all of it where the engine's
   // normal force does no work.
-  const Scene s = frictionless_top();
+  const Scene s = fixtures::dimensionless_scene(FrictionLaw::None);
   const double scale = s.mass.mass * s.gravity * s.body.sphere_radius;  // M g R, the energy scale
   for (const std::string& engine : engines()) {
     TrajectorySink sink;
@@ -170,7 +157,7 @@ TEST(EnergyLedger, ViscousWorkBookedIsTheFrictionWork) {
 TEST(EnergyLedger, ElasticEnergyIsTheContactLawsPotentialOrNotAvailable) {
   // At rest on the ball the soft contacts with a potential (ODE's ERP/CFM spring, Simbody's
   // Hertz law) store energy, never a negative amount; a contact without one says n/a.
-  Scene s = frictionless_top();
+  Scene s = fixtures::dimensionless_scene(FrictionLaw::None);
   s.initial.tilt = 0.0;
   s.initial.spin = 0.0;
   s.contact.friction = FrictionLaw::Coulomb;
@@ -200,7 +187,7 @@ TEST(EnergyLedger, OdesResolvedSpringStoresTheWeightsPotential) {
   // above the round-off of the depth (a difference of O(1) positions, ~1e-16 R over 5e-7 R,
   // doubled by the square: ~4e-10).
   if (std::find(engines().begin(), engines().end(), "ode") == engines().end()) GTEST_SKIP() << "ODE not built";
-  Scene s = frictionless_top();
+  Scene s = fixtures::dimensionless_scene(FrictionLaw::None);
   s.initial.tilt = 0.0;
   s.initial.spin = 0.0;
   s.engines["ode"]["soft_cfm"] = 1e-3;

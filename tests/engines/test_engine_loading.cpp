@@ -14,6 +14,7 @@
 #include "step_checks.h"
 #include "support/process.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace {
 

@@ -14,6 +14,7 @@
 #include "adapters.h"
 #include "registry.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "simulator.h"
 #include "support/reference_runs.h"
 

@@ -25,6 +25,7 @@
 #include "records/records.h"
 #include "measure/run.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "simulator.h"
 #include "support/process.h"
 

@@ -8,6 +8,7 @@
 #include "adapters.h"
 #include "bullet_sim.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace tippe {
 namespace {

@@ -24,6 +24,7 @@
 #include "adapters.h"
 #include "mujoco_sim.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "simulator.h"
 
 namespace tippe {

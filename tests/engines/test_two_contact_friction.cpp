@@ -11,6 +11,7 @@
 #include "measure/run.h"
 #include "registry.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace tippe {
 namespace {

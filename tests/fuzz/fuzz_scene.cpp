@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace {
 

@@ -26,27 +26,23 @@ inline const std::string kSourceDir = TIPPE_SOURCE_DIR;
 inline const std::string kTippeBinary = std::string(TIPPE_BINARY_DIR) + "/tippe";
 inline const std::string kScenesDir = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/";
 
-// The dimensionless top: g = R = M = 1, mass properties given directly.
-inline Scene dimensionless_scene() {
+// The source's dimensionless top (REFERENCE_VALUES.md): g = R = M = 1, r = 0.25, l = 1.2, h = 0.9,
+// d = 0.3, A = 0.4, C = 0.45 given directly, tilt 0.1 rad, spin 5, 2 time units sampled every 0.01.
+// `law` takes `coefficient` as its own (mu for coulomb and gliding, k for viscous; rolling and none
+// have none): Coulomb mu = 0.3, the source's, by default. Every test of this body starts here.
+inline Scene dimensionless_scene(FrictionLaw law = FrictionLaw::Coulomb, double coefficient = 0.3) {
   Scene s;
   s.name = "dimensionless";
   s.gravity = 1.0;
-  s.body.sphere_radius = 1.0;
-  s.body.stem_radius = 0.25;
-  s.body.stem_length = 1.2;
-  s.body.truncation_height = 0.9;
-  s.body.mass_model = MassModel::Given;
-  s.mass.mass = 1.0;
-  s.mass.com_offset = 0.3;
-  s.mass.inertia_transverse = 0.4;
-  s.mass.inertia_axial = 0.45;
-  s.contact.friction = FrictionLaw::Coulomb;
-  s.contact.mu = 0.3;
+  s.body = {1.0, 0.25, 1.2, 0.9, 0.0, MassModel::Given};
+  s.mass = {1.0, 0.3, 0.4, 0.45};
+  s.contact.friction = law;
+  if (law == FrictionLaw::Coulomb || law == FrictionLaw::Gliding) s.contact.mu = coefficient;
+  if (law == FrictionLaw::Viscous) s.contact.k = coefficient;
   s.contact.stem = true;
   s.initial.tilt = 0.1;
   s.initial.spin = 5.0;
-  s.run.duration = 2.0;
-  s.run.sample_interval = 0.01;
+  s.run = {2.0, 0.01, 1e-10, 1e-12};
   return s;
 }
 

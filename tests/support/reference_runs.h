@@ -12,6 +12,7 @@
 
 #include "initial_state.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "observables.h"
 #include "reference_model.h"
 

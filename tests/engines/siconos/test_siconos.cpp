@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "registry.h"
 
 namespace tippe {

@@ -6,24 +6,10 @@
 #include <string>
 
 #include "registry.h"
+#include "support/fixtures.h"
 
 namespace tippe {
 namespace {
-
-// The dimensionless body of the source (REFERENCE_VALUES.md), as in the conformance suite.
-Scene base_scene() {
-  Scene s;
-  s.name = "simbody";
-  s.gravity = 1.0;
-  s.body = {1.0, 0.25, 1.2, 0.9, 0.0, MassModel::Given};
-  s.mass = {1.0, 0.3, 0.4, 0.45};
-  s.contact.friction = FrictionLaw::Coulomb;
-  s.contact.mu = 0.3;
-  s.initial.tilt = 0.1;
-  s.initial.spin = 5.0;
-  s.run = {2.0, 0.01, 1e-10, 1e-12};
-  return s;
-}
 
 TEST(Simbody, RestsAtTheHertzDepthOfItsStiffness) {
   // At rest upright the Hertz force carries the weight: M g = (4/3) E_eff sqrt(R) x^(3/2) with
@@ -31,7 +17,7 @@ TEST(Simbody, RestsAtTheHertzDepthOfItsStiffness) {
   // G sinks by x = (3 M g 2^(3/2) / (4 E sqrt(R)))^(2/3). A large dissipation damps the ringing
   // of the zero-depth start; the force law's stiffness part alone sets the depth. 1e-3 of x:
   // the ringing left after 3 time units (damping ratio 0.4 at c = 500) is far below it.
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.initial.tilt = 0.0;
   s.initial.spin = 0.0;
   const double E = 1e6;
@@ -53,7 +39,7 @@ TEST(Simbody, GlidingLawIsSimbodysViscousFriction) {
   // (static and dynamic 0), its own contact force gives that law. 2e-3 relative: the Hertz
   // ringing of the normal force (damped here by c = 500) and the creep of the friction's
   // regularization (none: uv has no transition).
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.contact.friction = FrictionLaw::Gliding;
   s.contact.mu = 1.0;
   s.contact.stem = false;
@@ -73,7 +59,7 @@ TEST(Simbody, GlidingLawIsSimbodysViscousFriction) {
 // The precession of a torque-free top after 2 time units against Euler's closed form, at a
 // given accuracy (the conformance suite's check, here as a function of the knob).
 double precession_error(double accuracy) {
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.gravity = 0.0;
   s.contact.flight = true;
   s.initial.height = 1.0;
@@ -97,7 +83,7 @@ TEST(Simbody, TighterAccuracyBuysPrecision) {
 }
 
 TEST(Simbody, RejectsStaticFrictionBelowDynamic) {
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.engines["simbody"]["static_friction"] = 0.2;  // dynamic from the scene: mu = 0.3
   try {
     make_simulator("simbody", s);
@@ -111,7 +97,7 @@ TEST(Simbody, RejectsStaticFrictionBelowDynamic) {
 }
 
 TEST(Simbody, DrillingIsNotedAsNotModelled) {
-  Scene s = base_scene();
+  Scene s = fixtures::dimensionless_scene();
   s.contact.drilling = 0.01;
   auto sim = make_simulator("simbody", s);
   bool noted = false;

@@ -13,6 +13,7 @@
 #include "gating/gate.h"
 #include "records/records.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "io/toml_reader.h"
 #include "sweep/sweep.h"
 #include "support/files.h"

@@ -9,6 +9,7 @@
 #include "gating/gate.h"
 #include "registry.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "sweep/sweep.h"
 
 namespace {

@@ -14,6 +14,7 @@
 #include "records/records.h"
 #include "measure/run.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "support/files.h"
 #include "support/fixtures.h"
 
@@ -244,28 +245,6 @@ TEST(SceneIo, OverridesApply) {
   EXPECT_EQ(std::get<double>(s.engines.at("ode").at("timestep")), 1e-4);
   const Scene q = load_scene(path, {"engines.ode.stepper=\"step\""});
   EXPECT_EQ(std::get<std::string>(q.engines.at("ode").at("stepper")), "step");
-}
-
-TEST(SceneIo, ReferenceSettingsInEnginesAnalyticAndTheirOlderSpelling) {
-  // [engines.analytic] is where the reference's settings live; [run]'s older keys are still read
-  // and listed (the reference notes them as deprecated); a key in both is refused (bad_scenes).
-  TempDir dir{"tippe-test"};
-  const std::string path =
-      dir.write("ref.toml", edit(edit(kBase, "rtol = 1e-10\n", ""), "atol = 1e-12\n", "") +
-                                "[engines.analytic]\nrtol = 1e-8\nmethod = \"dopri5\"\nself_check = false\n");
-  const Scene s = load_scene(path);
-  EXPECT_EQ(s.run.rtol, 1e-8);
-  EXPECT_EQ(s.run.method, "dopri5");
-  EXPECT_FALSE(s.run.self_check);
-  EXPECT_TRUE(make_simulator("analytic", s)->notes().empty());
-  const Scene old = load_scene(dir.write("old.toml", kBase));
-  ASSERT_FALSE(old.run.alias_keys.empty());
-  const auto notes = make_simulator("analytic", old)->notes();
-  ASSERT_EQ(notes.size(), 1u);
-  EXPECT_NE(notes[0].find("run.rtol"), std::string::npos) << notes[0];
-  EXPECT_NE(notes[0].find("deprecated"), std::string::npos) << notes[0];
-  const Scene fresh = load_scene(dir.write("new.toml", edit(edit(kBase, "rtol = 1e-10\n", ""), "atol = 1e-12\n", "")));
-  EXPECT_TRUE(fresh.run.alias_keys.empty());
 }
 
 TEST(SceneIo, HashIsStableAndSeesOverridesAndBytes) {

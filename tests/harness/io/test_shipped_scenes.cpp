@@ -8,6 +8,7 @@
 
 #include "../analytic/reference_model.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 
 namespace tippe {
 namespace {

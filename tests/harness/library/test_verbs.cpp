@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "library/columns.h"
 #include "library/verbs.h"
 #include "measure/run.h"

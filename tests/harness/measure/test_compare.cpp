@@ -18,6 +18,7 @@
 #include "records/records.h"
 #include "report/report.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "support/files.h"
 
 namespace fs = std::filesystem;

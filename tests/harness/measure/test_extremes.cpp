@@ -14,6 +14,7 @@
 #include "observables.h"
 #include "reference_model.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "sweep/sweep.h"
 #include "support/files.h"
 #include "report/sweep_analysis.h"

@@ -13,6 +13,7 @@
 #include "gating/gate_boundary.h"
 #include "simulator.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "sweep/sweep.h"
 #include "sweep/sweep_search.h"
 #include "support/files.h"

@@ -6,6 +6,7 @@
 
 #include "io/files.h"
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "measure/compare.h"
 #include "report/sweep_analysis.h"
 #include "sweep/sweep.h"

@@ -1,0 +1,186 @@
+// Tests of the sweep analysis on synthetic records (harness/report/sweep_analysis.h): orders of convergence, the cheapest setting below each bound, the regime along the step, and the sweep report's Markdown.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "report/sweep_analysis.h"
+#include "support/sweep_points.h"
+
+using namespace tippe;
+
+namespace {
+
+using fixtures::point;
+
+}  // namespace
+
+// ---- analysis ---------------------------------------------------------------------------------
+
+TEST(SweepAnalysis, ExactPowerLawGivesItsOrderOverEveryPoint) {
+  const std::vector<double> h = {1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5};
+  for (double order : {1.0, 2.0, 4.0}) {
+    std::vector<double> e;
+    for (double x : h) e.push_back(7.0 * std::pow(x, order));
+    const ConvergenceFit f = convergence_order(h, e);
+    ASSERT_TRUE(f.ok) << f.note;
+    EXPECT_NEAR(f.order, order, 1e-9);
+    EXPECT_EQ(f.used, (std::vector<size_t>{5, 4, 3, 2, 1, 0})) << "every point, in increasing h";
+  }
+}
+
+TEST(SweepAnalysis, FloorAndSaturationAreLeftOutOfTheAsymptoticRange) {
+  // Error 1000 h^2 above a floor of 1e-7 at the fine end and saturated at 0.5 at the coarse end.
+  const std::vector<double> h = {3e-1, 1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5, 1e-6};
+  std::vector<double> e;
+  for (double x : h) e.push_back(std::min(0.5, 1000 * x * x) + 1e-7);
+  const ConvergenceFit f = convergence_order(h, e);
+  ASSERT_TRUE(f.ok) << f.note;
+  EXPECT_NEAR(f.order, 2.0, 0.1);
+  std::set<double> used;
+  for (size_t i : f.used) used.insert(h[i]);
+  EXPECT_FALSE(used.count(1e-6)) << "on the floor";
+  EXPECT_FALSE(used.count(1e-1)) << "saturated";
+  EXPECT_FALSE(used.count(3e-1)) << "saturated";
+  for (double x : {1e-2, 1e-3, 1e-4}) EXPECT_TRUE(used.count(x)) << x;
+}
+
+TEST(SweepAnalysis, NoConvergenceIsSaid) {
+  EXPECT_FALSE(convergence_order({1e-2, 1e-3, 1e-4}, {0.1, 0.1, 0.1}).ok);
+  EXPECT_FALSE(convergence_order({1e-2}, {0.1}).ok);
+  // Non-finite and zero errors do not count.
+  const ConvergenceFit f = convergence_order({1e-2, 1e-3, 1e-4}, {1e-4, std::nan(""), 0.0});
+  EXPECT_FALSE(f.ok);
+  const ConvergenceFit two = convergence_order({1e-2, 1e-3, 1e-4}, {1e-2, 1e-3, std::nan("")});
+  ASSERT_TRUE(two.ok);
+  EXPECT_NEAR(two.order, 1.0, 1e-12);
+  EXPECT_EQ(two.note, "only 2 points");
+}
+
+TEST(SweepAnalysis, CheapestSettingBelowEachBound) {
+  // Two setups of engine A and one of B; errors of either sign; a diverged run never counts.
+  std::vector<SweepRecord> a = {point("a", "a-euler", 1e-2, 1.0, 0.2), point("a", "a-euler", 1e-3, 2.0, -0.05),
+                                point("a", "a-euler", 1e-4, 4.0, 0.005), point("a", "a-rk4", 1e-2, 3.0, 0.004),
+                                point("a", "a-rk4", 1e-3, 6.0, 0.0002)};
+  EXPECT_EQ(cheapest_below(a, 0.1), 1);
+  EXPECT_EQ(cheapest_below(a, 0.01), 3) << "the RK4 setup is cheaper than Euler at 1e-4";
+  EXPECT_EQ(cheapest_below(a, 0.001), 4);
+  EXPECT_EQ(cheapest_below(a, 1e-5), -1);
+
+  std::vector<SweepRecord> b = {point("b", "b", 1e-2, 0.5, 0.08), point("b", "b", 1e-3, 3.0, 0.0005, "diverged"),
+                                point("b", "b", 1e-4, 5.0, -0.0009), point("b", "b", 1e-5, 9.0, std::nullopt)};
+  EXPECT_EQ(cheapest_below(b, 0.1), 0);
+  EXPECT_EQ(cheapest_below(b, 0.01), 2) << "the diverged point is skipped";
+  EXPECT_EQ(cheapest_below(b, 0.001), 2);
+  EXPECT_EQ(cheapest_below(b, 0.0009), 2) << "the bound is inclusive, as every criterion's |METRIC| <= BOUND";
+  EXPECT_EQ(cheapest_below(b, 0.00089), -1);
+
+  // The analytic side: the cheapest point at least as accurate.
+  std::vector<SweepRecord> an = {point("analytic", "bs", 1e-4, 0.002, 1e-5), point("analytic", "bs", 1e-8, 0.004, 1e-9),
+                                 point("analytic", "dp", 1e-4, 0.003, 3e-6)};
+  EXPECT_EQ(cheapest_at_least_as_accurate(an, 0.005), 0);
+  EXPECT_EQ(cheapest_at_least_as_accurate(an, 5e-6), 2);
+  EXPECT_EQ(cheapest_at_least_as_accurate(an, 1e-9), 1) << "equal accuracy counts";
+  EXPECT_EQ(cheapest_at_least_as_accurate(an, 1e-10), -1);
+}
+
+TEST(SweepAnalysis, SoftestSettingInTheReferencesRegime) {
+  // The reference rolls (no inversion): a point agrees when it finishes without inverting.
+  auto rolling = [](double dt, std::optional<double> inversion, const std::string& status = "ok") {
+    SweepRecord r;
+    r.ladder_key = "engines.ode.timestep";
+    r.ladder_value = dt;
+    r.inversion_time = inversion;
+    r.status = status;
+    return r;
+  };
+  std::vector<SweepRecord> s = {rolling(1e-2, 3.0), rolling(3e-3, std::nullopt), rolling(1e-3, std::nullopt),
+                                rolling(1e-4, std::nullopt)};
+  EXPECT_FALSE(agrees_with_reference_regime(s[0]));
+  EXPECT_TRUE(agrees_with_reference_regime(s[1]));
+  EXPECT_EQ(softest_agreeing(s), 1);
+  // Walking from the finest: a diverged run at 3e-3 stops the walk although 1e-2 agrees again.
+  s = {rolling(1e-2, std::nullopt), rolling(3e-3, std::nullopt, "diverged"), rolling(1e-3, std::nullopt)};
+  EXPECT_EQ(softest_agreeing(s), 2);
+  s = {rolling(1e-3, 1.0), rolling(1e-4, 1.0)};
+  EXPECT_EQ(softest_agreeing(s), -1);
+
+  // An inverting reference: a run that inverts agrees, even if it diverges later.
+  SweepRecord inv = rolling(1e-3, 4.0, "diverged");
+  inv.reference_inversion_time = 4.3;
+  EXPECT_TRUE(agrees_with_reference_regime(inv));
+
+  // Iterations: fewer is softer.
+  EXPECT_TRUE(larger_is_softer("engines.mujoco.timestep"));
+  EXPECT_TRUE(larger_is_softer("run.rtol"));
+  EXPECT_FALSE(larger_is_softer("engines.bullet.solver_iterations"));
+  EXPECT_FALSE(larger_is_softer("engines.ode.iterations"));
+  std::vector<SweepRecord> it = {rolling(5, 2.0), rolling(10, std::nullopt), rolling(50, std::nullopt)};
+  for (auto& r : it) r.ladder_key = "engines.ode.iterations";
+  EXPECT_EQ(softest_agreeing(it), 1);
+}
+
+// Leaving the reference's rolling regime, as the step shrinks: gone at the finest steps, moved
+// later, or staying; a diverged run is left out; "mixed" when the regime comes and goes.
+TEST(SweepAnalysis, RegimeTrendAlongTheStep) {
+  auto point = [](double dt, std::optional<double> inversion, const std::string& status = "ok") {
+    SweepRecord r;
+    r.ladder_key = "engines.ode.timestep";
+    r.ladder_value = dt;
+    r.inversion_time = inversion;
+    r.status = status;
+    return r;
+  };
+  // ODE on toy to 30 s as measured (4.87 s at 3e-4, 13.2 s at 1e-4, none at 3e-5).
+  RegimeTrend tr = regime_trend({point(1e-3, 1.84), point(3e-4, 4.87), point(1e-4, 13.2), point(3e-5, std::nullopt)});
+  EXPECT_EQ(tr.verdict, "goes away");
+  ASSERT_TRUE(tr.in_regime_from);
+  EXPECT_EQ(*tr.in_regime_from, 3e-5);
+  ASSERT_EQ(tr.inversion_by_step.size(), 3u);
+  EXPECT_EQ(tr.inversion_by_step.front().first, 1e-3) << "coarsest first";
+  // Every finished run inverts, later as the step falls: the departure only moves (ODE on the
+  // Leine-Glocker twin: 0.899, 2.02, 4.84, 14.4 s).
+  tr = regime_trend({point(1e-4, 9.0), point(1e-3, 2.0), point(3e-4, 5.0), point(3e-2, 0.1, "diverged")});
+  EXPECT_EQ(tr.verdict, "moves later") << "sorted by step, the diverged run left out";
+  EXPECT_FALSE(tr.in_regime_from);
+  // The two finest within 1 %: converged (MuJoCo on toy: 16.6, 17.0, 17.02, 17.01 s).
+  EXPECT_EQ(regime_trend({point(1e-3, 16.58), point(3e-4, 16.98), point(1e-4, 17.02), point(3e-5, 17.01)}).verdict,
+            "converges");
+  EXPECT_EQ(regime_trend({point(1e-3, 1.309), point(1e-4, 1.309), point(2e-5, 1.31)}).verdict, "converges");
+  // Earlier at a finer step, the two apart: neither.
+  EXPECT_EQ(regime_trend({point(1e-3, 5.0), point(1e-4, 2.0)}).verdict, "earlier at a finer step");
+  EXPECT_EQ(regime_trend({point(1e-3, std::nullopt), point(1e-4, std::nullopt)}).verdict, "none");
+  EXPECT_EQ(regime_trend({point(1e-3, 2.0), point(3e-4, std::nullopt), point(1e-4, 3.0), point(3e-5, std::nullopt)}).verdict,
+            "mixed");
+  // Not answerable: one finished run; the reference inverts; not a time step.
+  EXPECT_EQ(regime_trend({point(1e-3, 2.0), point(1e-4, 2.0, "diverged")}).verdict, "-");
+  SweepRecord inv = point(1e-3, 4.0);
+  inv.reference_inversion_time = 4.3;
+  EXPECT_EQ(regime_trend({inv, inv}).verdict, "-");
+  SweepRecord iters = point(10, 2.0);
+  iters.ladder_key = "engines.ode.iterations";
+  EXPECT_EQ(regime_trend({iters, iters}).verdict, "-");
+}
+
+TEST(SweepReport, MarkdownNamesTheCheapestPointsAndOrders) {
+  std::vector<SweepRecord> recs;
+  const std::vector<double> h = {1e-2, 1e-3, 1e-4};
+  long long k = 0;
+  for (double dt : h) {
+    SweepRecord r = point("ode", "ode", dt, 1e-3 / dt, 3.0 * dt * dt);
+    r.scene = "fixture";
+    r.metrics.tilt_rms_error = 0.1 * dt;
+    r.ladder_index = k++;
+    r.point_id = "p" + std::to_string(k);
+    recs.push_back(r);
+  }
+  const std::string md = render_sweep_markdown(recs);
+  EXPECT_NE(md.find("| ode | 1 % | ode | engines.ode.timestep = 0.01 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 2.00 | dt = 0.0001, 0.001, 0.01 | 1.00 |"), std::string::npos) << md;
+  // Duplicated point ids (a line written twice) count once.
+  recs.push_back(recs.front());
+  EXPECT_EQ(render_sweep_markdown(recs), md);
+}
