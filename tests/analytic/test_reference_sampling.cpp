@@ -6,6 +6,7 @@
 #include <string>
 
 #include "io/scene_io.h"
+#include "scene/resolve.h"
 #include "measure/run.h"
 
 namespace tippe {
