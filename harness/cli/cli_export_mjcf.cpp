@@ -2,11 +2,11 @@
 #include <iostream>
 #include <memory>
 
-#include "cli/cli.h"
-#include "io/output_dir.h"
-#include "mujoco_api.h"
-#include "records/records.h"
-#include "io/scene_io.h"
+#include "harness/cli/cli.h"
+#include "harness/io/output_dir.h"
+#include "engines/mujoco/mujoco_api.h"
+#include "harness/records/records.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe::cli {
 

@@ -3,11 +3,11 @@
 #include <cstdio>
 #include <memory>
 
-#include "cli/cli.h"
-#include "mass_properties.h"
-#include "registry.h"
-#include "io/scene_io.h"
-#include "simulator.h"
+#include "harness/cli/cli.h"
+#include "analytic/mass_properties.h"
+#include "engines/core/registry.h"
+#include "harness/io/scene_io.h"
+#include "engines/core/simulator.h"
 
 namespace tippe::cli {
 

@@ -5,12 +5,12 @@
 #include <iostream>
 #include <memory>
 
-#include "cli/cli.h"
-#include "io/progress.h"
-#include "registry.h"
-#include "records/records.h"
-#include "measure/run.h"
-#include "io/scene_io.h"
+#include "harness/cli/cli.h"
+#include "harness/io/progress.h"
+#include "engines/core/registry.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe::cli {
 

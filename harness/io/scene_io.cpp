@@ -1,10 +1,10 @@
 // Reading scene files: TOML -> Scene with every key checked, and command-line overrides.
-#include "io/scene_io.h"
-#include "io/hash.h"
-#include "io/text.h"
+#include "harness/io/scene_io.h"
+#include "harness/io/hash.h"
+#include "harness/io/text.h"
 
-#include "registry.h"
-#include "io/toml_reader.h"
+#include "engines/core/registry.h"
+#include "harness/io/toml_reader.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -21,9 +21,9 @@
 
 #include <toml++/toml.h>
 
-#include "adapters.h"
-#include "mass_properties.h"
-#include "io/files.h"
+#include "engines/core/adapters.h"
+#include "analytic/mass_properties.h"
+#include "harness/io/files.h"
 
 namespace tippe {
 

@@ -6,11 +6,11 @@
 #include <locale>
 #include <sstream>
 
-#include "io/output_dir.h"
-#include "io/scene_io.h"
-#include "library/verbs.h"
-#include "mujoco_api.h"
-#include "settings.h"
+#include "harness/io/output_dir.h"
+#include "harness/io/scene_io.h"
+#include "harness/library/verbs.h"
+#include "engines/mujoco/mujoco_api.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

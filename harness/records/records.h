@@ -13,9 +13,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/files.h"
-#include "scene.h"
-#include "simulator.h"
+#include "harness/io/files.h"
+#include "analytic/scene.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
-#include "support/fixtures.h"
-#include "support/reference_runs.h"
-#include "simulator.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/reference_runs.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 namespace {

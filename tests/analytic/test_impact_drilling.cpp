@@ -7,9 +7,9 @@
 #include <random>
 #include <string>
 
-#include "contact_dynamics.h"
-#include "reference_model.h"
-#include "io/scene_io.h"
+#include "analytic/contact_dynamics.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe {
 namespace {

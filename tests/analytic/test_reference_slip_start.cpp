@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "initial_state.h"
-#include "reference_model.h"
-#include "io/scene_io.h"
-#include "support/fixtures.h"
-#include "support/reference_runs.h"
+#include "analytic/initial_state.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/reference_runs.h"
 
 namespace tippe {
 namespace {

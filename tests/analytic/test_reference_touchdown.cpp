@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/initial_state.h"
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
+#include "analytic/initial_state.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe {
 namespace {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe {
 namespace {

@@ -3,10 +3,10 @@
 
 #include <sys/resource.h>
 
-#include "../../analytic/contact_dynamics.h"
-#include "../../analytic/initial_state.h"
-#include "../../analytic/reference_model.h"
-#include "io/scene_io.h"
+#include "analytic/contact_dynamics.h"
+#include "analytic/initial_state.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe {
 namespace {

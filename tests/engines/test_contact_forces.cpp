@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <string>
 
-#include "bench_friction.h"
-#include "io/scene_io.h"
-#include "registry.h"
-#include "simulator.h"
+#include "engines/core/bench_friction.h"
+#include "harness/io/scene_io.h"
+#include "engines/core/registry.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 namespace {

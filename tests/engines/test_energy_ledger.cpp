@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
-#include "measure/run.h"
-#include "records/trajectory.h"
-#include "registry.h"
-#include "simulator.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/measure/run.h"
+#include "harness/records/trajectory.h"
+#include "engines/core/registry.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 namespace {

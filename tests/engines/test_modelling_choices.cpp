@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "adapters.h"
-#include "bullet_sim.h"
-#include "io/scene_io.h"
+#include "engines/core/adapters.h"
+#include "engines/bullet/bullet_sim.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe {
 namespace {

@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "adapters.h"
-#include "mujoco_sim.h"
-#include "io/scene_io.h"
-#include "simulator.h"
+#include "engines/core/adapters.h"
+#include "engines/mujoco/mujoco_sim.h"
+#include "harness/io/scene_io.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 namespace {

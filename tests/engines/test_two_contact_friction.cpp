@@ -7,10 +7,10 @@
 #include <utility>
 #include <vector>
 
-#include "records/records.h"
-#include "measure/run.h"
-#include "registry.h"
-#include "io/scene_io.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "engines/core/registry.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/scene_io.h"
+#include "harness/io/scene_io.h"
 
 namespace {
 

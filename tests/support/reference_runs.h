@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "initial_state.h"
-#include "io/scene_io.h"
-#include "observables.h"
-#include "reference_model.h"
+#include "analytic/initial_state.h"
+#include "harness/io/scene_io.h"
+#include "analytic/observables.h"
+#include "analytic/reference_model.h"
 
 namespace tippe::fixtures {
 

@@ -18,8 +18,8 @@
 #include <thread>
 #include <vector>
 
-#include "io/scene_io.h"
-#include "registry.h"
+#include "harness/io/scene_io.h"
+#include "engines/core/registry.h"
 
 namespace tippe {
 namespace {

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "registry.h"
+#include "engines/core/registry.h"
 
 namespace tippe {
 namespace {

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "gating/gate.h"
-#include "registry.h"
-#include "io/scene_io.h"
-#include "sweep/sweep.h"
+#include "harness/gating/gate.h"
+#include "engines/core/registry.h"
+#include "harness/io/scene_io.h"
+#include "harness/sweep/sweep.h"
 
 namespace {
 

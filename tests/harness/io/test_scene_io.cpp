@@ -11,11 +11,11 @@
 #include <limits>
 #include <sstream>
 
-#include "records/records.h"
-#include "measure/run.h"
-#include "io/scene_io.h"
-#include "support/files.h"
-#include "support/fixtures.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "harness/io/scene_io.h"
+#include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

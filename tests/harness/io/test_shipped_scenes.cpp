@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe {
 namespace {

@@ -5,11 +5,11 @@
 #include <string>
 #include <vector>
 
-#include "measure/classify.h"
-#include "measure/compare.h"
-#include "records/records.h"
-#include "measure/run.h"
-#include "io/scene_io.h"
+#include "harness/measure/classify.h"
+#include "harness/measure/compare.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe {
 namespace {
