@@ -7,7 +7,7 @@
 // Each constraint row says that a component of the acceleration of the material point at C
 // vanishes: n . (a_G + dw/dt x R_C + w x (w x r_GO)) = 0, with r_GO the vector from G to the
 // centre of the contacting sphere (the lowest point moves over the sphere, the centre does not).
-#include "contact_dynamics.h"
+#include "analytic/contact_dynamics.h"
 
 #include <Eigen/Dense>
 #include <algorithm>

@@ -4,9 +4,9 @@
 
 #include <array>
 
-#include "observables.h"
-#include "scene.h"
-#include "state.h"
+#include "analytic/observables.h"
+#include "analytic/scene.h"
+#include "analytic/state.h"
 
 namespace tippe {
 

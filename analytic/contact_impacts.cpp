@@ -1,5 +1,5 @@
 // Impulses at the contacts: touchdown impacts with their friction laws, the normal projections, and stopping a contact.
-#include "contact_dynamics.h"
+#include "analytic/contact_dynamics.h"
 
 #include <Eigen/Dense>
 #include <algorithm>

@@ -1,7 +1,7 @@
 // The reference's dense-output integrators: Boost.Odeint's Bulirsch-Stoer and Dormand-Prince 5(4), and Rosenbrock4 on ublas vectors.
-#include "detail/dense_stepper.h"
+#include "analytic/detail/dense_stepper.h"
 
-#include "boost_binomial.h"  // first: it must precede every Boost.Math and Odeint header
+#include "analytic/boost_binomial.h"  // first: it must precede every Boost.Math and Odeint header
 #include <boost/numeric/odeint.hpp>
 
 #include <algorithm>

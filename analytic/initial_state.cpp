@@ -1,5 +1,5 @@
 // The scene's initial state, shared by the reference and every engine so that all start alike.
-#include "initial_state.h"
+#include "analytic/initial_state.h"
 
 namespace tippe {
 

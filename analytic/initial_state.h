@@ -1,9 +1,9 @@
 // The scene's initial state, shared by the reference and every engine so that all start alike.
 #pragma once
 
-#include "observables.h"
-#include "scene.h"
-#include "state.h"
+#include "analytic/observables.h"
+#include "analytic/scene.h"
+#include "analytic/state.h"
 
 namespace tippe {
 

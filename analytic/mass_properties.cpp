@@ -1,5 +1,5 @@
 // Mass properties of the sphere+stem body (seed and exact-solid conventions) and geometry checks.
-#include "mass_properties.h"
+#include "analytic/mass_properties.h"
 
 #include <algorithm>
 #include <array>

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "scene.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 

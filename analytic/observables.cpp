@@ -1,5 +1,5 @@
 // Observables shared by every simulator, computed from the common state by one function.
-#include "observables.h"
+#include "analytic/observables.h"
 
 #include <algorithm>
 #include <cmath>

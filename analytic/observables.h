@@ -1,8 +1,8 @@
 // Observables shared by every simulator: tilt, geometric contact, energy and Jellett's integral.
 #pragma once
 
-#include "scene.h"
-#include "state.h"
+#include "analytic/scene.h"
+#include "analytic/state.h"
 
 namespace tippe {
 

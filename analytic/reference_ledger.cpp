@@ -3,7 +3,7 @@
 #include <array>
 #include <cmath>
 
-#include "detail/reference_impl.h"
+#include "analytic/detail/reference_impl.h"
 
 namespace tippe {
 

@@ -1,9 +1,9 @@
 // The analytic reference: adaptive integration with dense output (Bulirsch-Stoer, Dormand-Prince
 // 5(4) or Rosenbrock4), events located by TOMS 748 root finding on the dense output, mode
 // changes (impacts, stick/slip, release) applied at the event.
-#include "reference_model.h"
+#include "analytic/reference_model.h"
 
-#include "boost_binomial.h"  // first: it must precede every Boost.Math and Odeint header
+#include "analytic/boost_binomial.h"  // first: it must precede every Boost.Math and Odeint header
 #include <boost/math/tools/toms748_solve.hpp>
 
 #include <algorithm>
@@ -11,9 +11,9 @@
 #include <limits>
 #include <sstream>
 
-#include "detail/reference_impl.h"
-#include "initial_state.h"
-#include "stop_request.h"
+#include "analytic/detail/reference_impl.h"
+#include "analytic/initial_state.h"
+#include "analytic/stop_request.h"
 
 namespace tippe {
 

@@ -7,9 +7,9 @@
 #include <utility>
 #include <vector>
 
-#include "contact_dynamics.h"
-#include "scene.h"
-#include "state.h"
+#include "analytic/contact_dynamics.h"
+#include "analytic/scene.h"
+#include "analytic/state.h"
 
 namespace tippe {
 

@@ -4,7 +4,7 @@
 #include <limits>
 #include <sstream>
 
-#include "detail/reference_impl.h"
+#include "analytic/detail/reference_impl.h"
 
 namespace tippe {
 

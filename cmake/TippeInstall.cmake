@@ -2,22 +2,29 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-# Installed headers, all under include/tippe/:
-#   tippe/tippe.h       the entry point of tippe::core (self-contained: no harness header is installed,
-#                       so harness files can move without changing the installed tree);
-#   tippe/analytic/*.h  the reference model (tippe::analytic), as in analytic/;
-#   tippe/engines/*.h   the simulator interface and adapter factories (tippe::engines). They include
-#                       "../analytic/..." relative to themselves, which the same layout keeps valid.
-set(TIPPE_INSTALLED_ENGINE_HEADERS simulator.h adapters.h)
+# Installed headers, all under include/tippe/ in the source tree's layout:
+#   tippe/tippe.h             the entry point of tippe::core (self-contained: no harness header is
+#                             installed, so harness files can move without changing the installed tree);
+#   tippe/analytic/*.h        the reference model (tippe::analytic), as in analytic/;
+#   tippe/engines/core/*.h    the simulator interface and adapter factories (tippe::engines), as in
+#                             engines/core/.
+# Project headers include each other by their path from the repository root ("analytic/scene.h"),
+# so include/tippe/ is the consumer's include directory for them, as the root is in the build;
+# include/ is the one for <tippe/tippe.h>.
+set(TIPPE_INSTALLED_ENGINE_HEADERS engines/core/simulator.h engines/core/adapters.h)
 
 set(TIPPE_LIBRARY_TARGETS tippe_analytic tippe_engines tippe_core)
 set_target_properties(tippe_analytic PROPERTIES EXPORT_NAME analytic)
 set_target_properties(tippe_engines PROPERTIES EXPORT_NAME engines)
 set_target_properties(tippe_core PROPERTIES EXPORT_NAME core)
-# The subdirectories give their source directories as include paths; those hold for the build
-# tree only. Installed, every target's headers are found from include/ (<tippe/...>).
+# The source tree's root is the build's include directory; it holds for the build tree only.
+# Installed, every target's headers are found from include/ (<tippe/tippe.h>) and include/tippe/
+# (the root-relative includes inside the installed headers).
 foreach(t ${TIPPE_LIBRARY_TARGETS})
   get_target_property(dirs ${t} INTERFACE_INCLUDE_DIRECTORIES)
+  if(NOT dirs)
+    set(dirs "")
+  endif()
   set(wrapped "")
   foreach(d ${dirs})
     if(d MATCHES "^\\$<")
@@ -26,7 +33,7 @@ foreach(t ${TIPPE_LIBRARY_TARGETS})
       list(APPEND wrapped "$<BUILD_INTERFACE:${d}>")
     endif()
   endforeach()
-  list(APPEND wrapped "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
+  list(APPEND wrapped "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>" "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/tippe>")
   set_target_properties(${t} PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${wrapped}")
 endforeach()
 
@@ -63,8 +70,10 @@ endif()
 install(FILES ${PROJECT_SOURCE_DIR}/include/tippe/tippe.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tippe)
 file(GLOB TIPPE_ANALYTIC_HEADERS ${PROJECT_SOURCE_DIR}/analytic/*.h)
 install(FILES ${TIPPE_ANALYTIC_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tippe/analytic)
-list(TRANSFORM TIPPE_INSTALLED_ENGINE_HEADERS PREPEND ${PROJECT_SOURCE_DIR}/engines/core/)
-install(FILES ${TIPPE_INSTALLED_ENGINE_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tippe/engines)
+foreach(h ${TIPPE_INSTALLED_ENGINE_HEADERS})
+  get_filename_component(dir ${h} DIRECTORY)
+  install(FILES ${PROJECT_SOURCE_DIR}/${h} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tippe/${dir})
+endforeach()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/schemas/ DESTINATION ${CMAKE_INSTALL_DATADIR}/tippe/schemas)
 
 set(TIPPE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/tippe)

@@ -20,23 +20,23 @@
 #include <string>
 #include <thread>
 
-#include <tippe/tippe.h>
+#include "include/tippe/tippe.h"
 #include <toml++/toml.h>
 
-#include "advise/advise.h"
-#include "io/output_dir.h"
-#include "io/progress.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "library/verbs.h"
-#include "measure/run.h"
-#include "records/sweep_record.h"
-#include "registry.h"
-#include "report/report.h"
-#include "report/sweep_analysis.h"
-#include "stop_request.h"
-#include "sweep/sweep.h"
-#include "sweep/sweep_search.h"
+#include "harness/advise/advise.h"
+#include "harness/io/output_dir.h"
+#include "harness/io/progress.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/library/verbs.h"
+#include "harness/measure/run.h"
+#include "harness/records/sweep_record.h"
+#include "engines/core/registry.h"
+#include "harness/report/report.h"
+#include "harness/report/sweep_analysis.h"
+#include "analytic/stop_request.h"
+#include "harness/sweep/sweep.h"
+#include "harness/sweep/sweep_search.h"
 
 namespace py = pybind11;
 namespace fs = std::filesystem;

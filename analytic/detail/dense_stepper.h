@@ -5,8 +5,8 @@
 #include <memory>
 #include <utility>
 
-#include "../contact_dynamics.h"
-#include "../scene.h"
+#include "analytic/contact_dynamics.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 namespace reference_detail {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "../reference_model.h"
-#include "dense_stepper.h"
+#include "analytic/reference_model.h"
+#include "analytic/detail/dense_stepper.h"
 
 namespace tippe {
 namespace reference_detail {

@@ -2,11 +2,11 @@
 #include <boost/version.hpp>
 #include <sstream>
 
-#include "../../analytic/reference_model.h"
-#include "adapters.h"
-#include "registry.h"
-#include "settings.h"
-#include "step_checks.h"
+#include "analytic/reference_model.h"
+#include "engines/core/adapters.h"
+#include "engines/core/registry.h"
+#include "engines/core/settings.h"
+#include "engines/core/step_checks.h"
 
 namespace tippe {
 

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "bullet_settings.h"
-#include "bullet_sim.h"
-#include "fixed_step.h"
+#include "engines/bullet/bullet_settings.h"
+#include "engines/bullet/bullet_sim.h"
+#include "engines/core/fixed_step.h"
 
 #ifndef BT_USE_DOUBLE_PRECISION
 #error "the Bullet adapter needs the double-precision build of Bullet (pkg-config bullet-float64)"

@@ -1,5 +1,5 @@
 // Bullet adapter, checks and notes: the rotation clamp and the dropped gyroscopic term watched each internal step, and the notes that state the run's modelling choices.
-#include "bullet_adapter.h"
+#include "engines/bullet/bullet_adapter.h"
 
 #include <cmath>
 #include <sstream>

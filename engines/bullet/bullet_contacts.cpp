@@ -1,5 +1,5 @@
 // Bullet adapter, contacts: the body-floor manifold points gathered into the bench's contact report, and the test-only readback of the engine objects.
-#include "bullet_adapter.h"
+#include "engines/bullet/bullet_adapter.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "settings.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

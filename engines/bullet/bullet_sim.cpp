@@ -1,15 +1,15 @@
 // Bullet 3.24 (double) adapter: one btRigidBody at G with a ball+stem compound shape on a static plane, stepped by the shared fixed-step loop; here its step, state and registration.
-#include "bullet_sim.h"
+#include "engines/bullet/bullet_sim.h"
 
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "adapters.h"
-#include "bullet_adapter.h"
-#include "registry.h"
-#include "settings.h"
+#include "engines/core/adapters.h"
+#include "engines/bullet/bullet_adapter.h"
+#include "engines/core/registry.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

@@ -1,9 +1,9 @@
 // Bullet adapter, construction: the world with its per-point material hook, the floor, the top's compound body at G and the solver's settings, from the scene.
-#include "bullet_adapter.h"
+#include "engines/bullet/bullet_adapter.h"
 
 #include <stdexcept>
 
-#include "settings.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "simulator.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

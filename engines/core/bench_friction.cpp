@@ -1,5 +1,5 @@
 // The viscous and gliding laws the bench applies at each contact an engine reports.
-#include "bench_friction.h"
+#include "engines/core/bench_friction.h"
 
 #include <algorithm>
 

@@ -2,8 +2,8 @@
 // every engine whose own contact is then frictionless.
 #pragma once
 
-#include "../../analytic/initial_state.h"
-#include "step_checks.h"
+#include "analytic/initial_state.h"
+#include "engines/core/step_checks.h"
 
 namespace tippe {
 

@@ -1,15 +1,15 @@
 // Shared stepping loop of the fixed-step engines: events, failure classification, viscous and
 // gliding laws, work.
-#include "fixed_step.h"
+#include "engines/core/fixed_step.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
-#include "../../analytic/stop_request.h"
-#include "bench_friction.h"
-#include "settings.h"
+#include "analytic/stop_request.h"
+#include "engines/core/bench_friction.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

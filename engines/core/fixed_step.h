@@ -5,11 +5,11 @@
 #include <string>
 #include <vector>
 
-#include "../../analytic/initial_state.h"
-#include "registry.h"
-#include "simulator.h"
-#include "bench_friction.h"
-#include "step_checks.h"
+#include "analytic/initial_state.h"
+#include "engines/core/registry.h"
+#include "engines/core/simulator.h"
+#include "engines/core/bench_friction.h"
+#include "engines/core/step_checks.h"
 
 namespace tippe {
 

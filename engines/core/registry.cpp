@@ -1,5 +1,5 @@
 // The registry of simulators: the reference, linked in, and the engines of engine_list.h (one line each), each loaded from its module on first use.
-#include "registry.h"
+#include "engines/core/registry.h"
 
 #include <algorithm>
 #include <atomic>
@@ -36,7 +36,7 @@ struct Slot {
 }  // namespace tippe
 // Linked in (TIPPE_ENGINE_MODULES=OFF): the entry points the modules would export.
 #define TIPPE_ENGINE(name) extern "C" const ::tippe::EngineInfo* tippe_engine_##name();
-#include "engine_list.h"
+#include "engines/core/engine_list.h"
 #undef TIPPE_ENGINE
 namespace tippe {
 namespace {
@@ -47,7 +47,7 @@ std::vector<Slot>& slots() {
     std::vector<Slot> v(1
 #ifndef TIPPE_REFERENCE_ONLY
 #define TIPPE_ENGINE(name) +1
-#include "engine_list.h"
+#include "engines/core/engine_list.h"
 #undef TIPPE_ENGINE
 #endif
     );
@@ -60,7 +60,7 @@ std::vector<Slot>& slots() {
 #else
 #define TIPPE_ENGINE(engine) v[i].name = #engine, v[i++].entry = tippe_engine_##engine;
 #endif
-#include "engine_list.h"
+#include "engines/core/engine_list.h"
 #undef TIPPE_ENGINE
 #endif
     return v;
@@ -193,7 +193,7 @@ bool engine_loaded(const std::string& name) {
 const std::vector<EngineFileSetting>& engine_file_settings() {
   static const std::vector<EngineFileSetting> all = {
 #define TIPPE_ENGINE_FILE(engine, key, what) {#engine, #key, what},
-#include "engine_list.h"
+#include "engines/core/engine_list.h"
 #undef TIPPE_ENGINE_FILE
   };
   return all;

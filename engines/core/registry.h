@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "settings.h"
-#include "simulator.h"
+#include "engines/core/settings.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 
@@ -85,7 +85,7 @@ EngineInfo engine_entry(std::string name, EngineRole role, std::function<std::un
 // one per line of engine_list.h, which its module hands over through its entry point.
 const EngineInfo& analytic_engine_info();
 #define TIPPE_ENGINE(name) const EngineInfo& name##_engine_info();
-#include "engine_list.h"
+#include "engines/core/engine_list.h"
 #undef TIPPE_ENGINE
 
 // An engine's entry point, one line at the end of its NAME_sim.cpp: the only symbol its module

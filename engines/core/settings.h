@@ -11,8 +11,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "../../analytic/scene.h"
-#include "simulator.h"
+#include "analytic/scene.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "../analytic/observables.h"
-#include "../analytic/scene.h"
-#include "../analytic/state.h"
+#include "analytic/observables.h"
+#include "analytic/scene.h"
+#include "analytic/state.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // The per-step checks every engine adapter shares: limits, step budget, events.
-#include "step_checks.h"
+#include "engines/core/step_checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "settings.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "../../analytic/initial_state.h"
-#include "simulator.h"
+#include "analytic/initial_state.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

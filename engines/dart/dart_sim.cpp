@@ -34,11 +34,11 @@
 #include <string>
 #include <vector>
 
-#include "adapters.h"
-#include "dart_settings.h"
-#include "fixed_step.h"
-#include "registry.h"
-#include "settings.h"
+#include "engines/core/adapters.h"
+#include "engines/dart/dart_settings.h"
+#include "engines/core/fixed_step.h"
+#include "engines/core/registry.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 namespace {

@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
-#include "../../analytic/scene.h"
-#include "mujoco_import.h"
-#include "registry.h"
+#include "analytic/scene.h"
+#include "engines/mujoco/mujoco_import.h"
+#include "engines/core/registry.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // Reads a user's MuJoCo model as a tippe top: loading the file, finding the body and checking what the reference can represent, and comparing a scene with it.
-#include "mujoco_top.h"
+#include "engines/mujoco/mujoco_top.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -12,9 +12,9 @@
 #include <sstream>
 #include <vector>
 
-#include "mujoco_import_analyser.h"
-#include "mujoco_settings.h"
-#include "settings.h"
+#include "engines/mujoco/mujoco_import_analyser.h"
+#include "engines/mujoco/mujoco_settings.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

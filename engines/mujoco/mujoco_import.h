@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "../../analytic/scene.h"
-#include "../../analytic/state.h"
+#include "analytic/scene.h"
+#include "analytic/state.h"
 
 namespace tippe {
 

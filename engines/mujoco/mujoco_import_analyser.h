@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "mujoco_top.h"
+#include "engines/mujoco/mujoco_top.h"
 
 namespace tippe::mjcf_import_detail {
 

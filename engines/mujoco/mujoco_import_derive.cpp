@@ -1,5 +1,5 @@
 // Derives the reference's top from a user's checked MuJoCo model: mass properties and symmetry axis, stem geometry, the contact law read from probe contacts, and the exact start.
-#include "mujoco_import_analyser.h"
+#include "engines/mujoco/mujoco_import_analyser.h"
 
 #include <algorithm>
 #include <cmath>

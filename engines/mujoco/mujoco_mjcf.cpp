@@ -1,5 +1,5 @@
 // The bench's MJCF of a scene: engines.mujoco settings checked, the contact as MuJoCo will use it, the model text and its compilation, and export-mjcf's text.
-#include "mujoco_mjcf.h"
+#include "engines/mujoco/mujoco_mjcf.h"
 
 #include <mujoco/mujoco.h>
 #include <algorithm>
@@ -13,13 +13,13 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-#include "adapters.h"
-#include "fixed_step.h"
-#include "mujoco_settings.h"
-#include "mujoco_top.h"
-#include "mujoco_user_model.h"
-#include "registry.h"
-#include "settings.h"
+#include "engines/core/adapters.h"
+#include "engines/core/fixed_step.h"
+#include "engines/mujoco/mujoco_settings.h"
+#include "engines/mujoco/mujoco_top.h"
+#include "engines/mujoco/mujoco_user_model.h"
+#include "engines/core/registry.h"
+#include "engines/core/settings.h"
 
 namespace tippe::mujoco_detail {
 

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "mujoco_settings.h"
-#include "observables.h"
-#include "scene.h"
-#include "state.h"
+#include "engines/mujoco/mujoco_settings.h"
+#include "analytic/observables.h"
+#include "analytic/scene.h"
+#include "analytic/state.h"
 
 namespace tippe::mujoco_detail {
 

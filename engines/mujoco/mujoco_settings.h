@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "../../analytic/scene.h"
-#include "settings.h"
+#include "analytic/scene.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // MuJoCo 2.2.2 adapter: the scene as MJCF (one free body at G with a ball and a stem geom on a plane), or the user's own MJCF as written, stepped by the shared fixed-step loop.
-#include "mujoco_sim.h"
+#include "engines/mujoco/mujoco_sim.h"
 
 #include <mujoco/mujoco.h>
 
@@ -15,15 +15,15 @@
 #include <string>
 #include <vector>
 
-#include "adapters.h"
-#include "fixed_step.h"
-#include "mujoco_api.h"
-#include "mujoco_mjcf.h"
-#include "mujoco_settings.h"
-#include "mujoco_top.h"
-#include "mujoco_user_model.h"
-#include "registry.h"
-#include "settings.h"
+#include "engines/core/adapters.h"
+#include "engines/core/fixed_step.h"
+#include "engines/mujoco/mujoco_api.h"
+#include "engines/mujoco/mujoco_mjcf.h"
+#include "engines/mujoco/mujoco_settings.h"
+#include "engines/mujoco/mujoco_top.h"
+#include "engines/mujoco/mujoco_user_model.h"
+#include "engines/core/registry.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 namespace {

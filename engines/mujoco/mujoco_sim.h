@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "simulator.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

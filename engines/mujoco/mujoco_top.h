@@ -6,7 +6,7 @@
 #include <mutex>
 #include <string>
 
-#include "mujoco_import.h"
+#include "engines/mujoco/mujoco_import.h"
 
 namespace tippe {
 

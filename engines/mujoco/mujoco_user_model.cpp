@@ -1,7 +1,7 @@
 // The MuJoCo adapter's user-model mode (engines.mujoco.model): the model checked against the scene, the scene's overrides on it, its notes and settings.
-#include "mujoco_user_model.h"
+#include "engines/mujoco/mujoco_user_model.h"
 
-#include "settings.h"
+#include "engines/core/settings.h"
 
 #include <algorithm>
 #include <sstream>

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "mujoco_settings.h"
-#include "mujoco_top.h"
-#include "simulator.h"
+#include "engines/mujoco/mujoco_settings.h"
+#include "engines/mujoco/mujoco_top.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

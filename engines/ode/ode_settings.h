@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "settings.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

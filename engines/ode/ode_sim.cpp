@@ -1,6 +1,6 @@
 // ODE 0.16 (double) adapter: one dBody at G carrying a ball and a stem geom on a plane, stepped by the shared fixed-step loop.
-#include "ode_sim.h"
-#include "ode_settings.h"
+#include "engines/ode/ode_sim.h"
+#include "engines/ode/ode_settings.h"
 
 #include <ode/ode.h>
 #include <ode/version.h>
@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "adapters.h"
-#include "fixed_step.h"
-#include "registry.h"
-#include "settings.h"
+#include "engines/core/adapters.h"
+#include "engines/core/fixed_step.h"
+#include "engines/core/registry.h"
+#include "engines/core/settings.h"
 
 // LeakSanitizer (part of ASan): present in sanitizer builds (scripts/sanitize.sh) only.
 #if defined(__SANITIZE_ADDRESS__)

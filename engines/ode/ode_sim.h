@@ -1,7 +1,7 @@
 // Test-only window into the ODE adapter: what its dBody holds, without exposing ODE types.
 #pragma once
 
-#include "simulator.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

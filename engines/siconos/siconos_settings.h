@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "settings.h"  // shared_settings: the bounds every engine gives the same key
+#include "engines/core/settings.h"  // shared_settings: the bounds every engine gives the same key
 
 namespace tippe {
 

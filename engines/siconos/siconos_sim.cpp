@@ -22,14 +22,14 @@
 #include <string>
 #include <vector>
 
-#include "../../analytic/initial_state.h"
-#include "../../analytic/stop_request.h"
-#include "bench_friction.h"
-#include "step_checks.h"
-#include "registry.h"
-#include "settings.h"
-#include "siconos_contact.h"
-#include "siconos_settings.h"
+#include "analytic/initial_state.h"
+#include "analytic/stop_request.h"
+#include "engines/core/bench_friction.h"
+#include "engines/core/step_checks.h"
+#include "engines/core/registry.h"
+#include "engines/core/settings.h"
+#include "engines/siconos/siconos_contact.h"
+#include "engines/siconos/siconos_settings.h"
 
 namespace tippe {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "../../analytic/scene.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 

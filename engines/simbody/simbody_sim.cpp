@@ -15,12 +15,12 @@
 #include <string>
 #include <vector>
 
-#include "../../analytic/initial_state.h"
-#include "../../analytic/stop_request.h"
-#include "step_checks.h"
-#include "registry.h"
-#include "settings.h"
-#include "simbody_settings.h"
+#include "analytic/initial_state.h"
+#include "analytic/stop_request.h"
+#include "engines/core/step_checks.h"
+#include "engines/core/registry.h"
+#include "engines/core/settings.h"
+#include "engines/simbody/simbody_settings.h"
 
 namespace tippe {
 namespace {

@@ -1,5 +1,5 @@
 // `tippe advise`: each engine's configurations from the registry, a boundary search of the cost knob in each, the cheapest confirmed one, and its gate.
-#include "advise/advise.h"
+#include "harness/advise/advise.h"
 
 #include <algorithm>
 #include <cctype>
@@ -9,17 +9,17 @@
 #include <map>
 #include <stdexcept>
 
-#include "gating/gate.h"
-#include "io/files.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "io/text.h"
-#include "measure/classify.h"
-#include "measure/metrics.h"
-#include "registry.h"
-#include "report/document.h"
-#include "report/sweep_analysis.h"
-#include "sweep/sweep.h"
+#include "harness/gating/gate.h"
+#include "harness/io/files.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/io/text.h"
+#include "harness/measure/classify.h"
+#include "harness/measure/metrics.h"
+#include "engines/core/registry.h"
+#include "harness/report/document.h"
+#include "harness/report/sweep_analysis.h"
+#include "harness/sweep/sweep.h"
 
 namespace tippe {
 

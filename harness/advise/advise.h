@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "records/sweep_record.h"
-#include "sweep/sweep_search.h"
+#include "harness/records/sweep_record.h"
+#include "harness/sweep/sweep_search.h"
 
 namespace tippe {
 

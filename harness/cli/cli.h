@@ -10,12 +10,12 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <tippe/tippe.h>
+#include "include/tippe/tippe.h"
 
-#include "io/interrupt.h"
-#include "io/output_dir.h"
-#include "io/scene_io.h"
-#include "registry.h"
+#include "harness/io/interrupt.h"
+#include "harness/io/output_dir.h"
+#include "harness/io/scene_io.h"
+#include "engines/core/registry.h"
 
 namespace tippe::cli {
 

@@ -3,9 +3,9 @@
 #include <memory>
 #include <stdexcept>
 
-#include "advise/advise.h"
-#include "cli/cli.h"
-#include "io/progress.h"
+#include "harness/advise/advise.h"
+#include "harness/cli/cli.h"
+#include "harness/io/progress.h"
 
 namespace tippe::cli {
 

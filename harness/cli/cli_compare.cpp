@@ -6,15 +6,15 @@
 #include <memory>
 #include <thread>
 
-#include "registry.h"
-#include "cli/cli.h"
-#include "library/verbs.h"
-#include "measure/compare.h"
-#include "report/report.h"
-#include "io/files.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "records/sweep_record.h"
+#include "engines/core/registry.h"
+#include "harness/cli/cli.h"
+#include "harness/library/verbs.h"
+#include "harness/measure/compare.h"
+#include "harness/report/report.h"
+#include "harness/io/files.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/records/sweep_record.h"
 
 namespace tippe::cli {
 

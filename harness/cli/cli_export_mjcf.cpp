@@ -2,12 +2,12 @@
 #include <iostream>
 #include <memory>
 
-#include "cli/cli.h"
-#include "io/output_dir.h"
-#include "mujoco_api.h"
-#include "records/records.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "harness/cli/cli.h"
+#include "harness/io/output_dir.h"
+#include "engines/mujoco/mujoco_api.h"
+#include "harness/records/records.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe::cli {
 

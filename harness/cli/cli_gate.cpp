@@ -6,16 +6,16 @@
 #include <memory>
 #include <thread>
 
-#include "cli/cli.h"
-#include "library/verbs.h"
-#include "measure/compare.h"
-#include "gating/gate.h"
-#include "gating/gate_boundary.h"
-#include "sweep/sweep_search.h"
-#include "io/output_dir.h"
-#include "records/records.h"
-#include "io/scene_io.h"
-#include "report/sweep_analysis.h"
+#include "harness/cli/cli.h"
+#include "harness/library/verbs.h"
+#include "harness/measure/compare.h"
+#include "harness/gating/gate.h"
+#include "harness/gating/gate_boundary.h"
+#include "harness/sweep/sweep_search.h"
+#include "harness/io/output_dir.h"
+#include "harness/records/records.h"
+#include "harness/io/scene_io.h"
+#include "harness/report/sweep_analysis.h"
 
 namespace tippe::cli {
 

@@ -7,11 +7,11 @@
 #include <memory>
 #include <sstream>
 
-#include "cli/cli.h"
-#include "library/verbs.h"
-#include "io/output_dir.h"
-#include "settings.h"
-#include "io/scene_io.h"
+#include "harness/cli/cli.h"
+#include "harness/library/verbs.h"
+#include "harness/io/output_dir.h"
+#include "engines/core/settings.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe::cli {
 

@@ -3,14 +3,14 @@
 #include <cstdio>
 #include <memory>
 
-#include "cli/cli.h"
-#include "mass_properties.h"
-#include "registry.h"
-#include "io/scene_io.h"
-#include "records/comparison.h"
-#include "records/record_schemas.h"
-#include "scene/resolve.h"
-#include "simulator.h"
+#include "harness/cli/cli.h"
+#include "analytic/mass_properties.h"
+#include "engines/core/registry.h"
+#include "harness/io/scene_io.h"
+#include "harness/records/comparison.h"
+#include "harness/records/record_schemas.h"
+#include "harness/scene/resolve.h"
+#include "engines/core/simulator.h"
 
 namespace tippe::cli {
 

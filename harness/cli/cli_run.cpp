@@ -5,13 +5,13 @@
 #include <iostream>
 #include <memory>
 
-#include "cli/cli.h"
-#include "io/progress.h"
-#include "registry.h"
-#include "records/records.h"
-#include "measure/run.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "harness/cli/cli.h"
+#include "harness/io/progress.h"
+#include "engines/core/registry.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe::cli {
 

@@ -6,12 +6,12 @@
 #include <optional>
 #include <thread>
 
-#include "cli/cli.h"
-#include "sweep/mpi_farm.h"
-#include "sweep/sweep_search.h"
-#include "io/scene_io.h"
-#include "sweep/sweep.h"
-#include "report/sweep_analysis.h"
+#include "harness/cli/cli.h"
+#include "harness/sweep/mpi_farm.h"
+#include "harness/sweep/sweep_search.h"
+#include "harness/io/scene_io.h"
+#include "harness/sweep/sweep.h"
+#include "harness/report/sweep_analysis.h"
 
 namespace tippe::cli {
 

@@ -5,12 +5,12 @@
 #include <string>
 #include <vector>
 
-#include "cli/cli.h"
-#include "io/progress.h"
-#include "io/provenance.h"
-#include "registry.h"
-#include "tippe/tippe.h"
-#include "io/scene_io.h"
+#include "harness/cli/cli.h"
+#include "harness/io/progress.h"
+#include "harness/io/provenance.h"
+#include "engines/core/registry.h"
+#include "include/tippe/tippe.h"
+#include "harness/io/scene_io.h"
 
 int main(int argc, char** argv) {
   using namespace tippe;

@@ -2,7 +2,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "sweep/mpi_farm.h"
+#include "harness/sweep/mpi_farm.h"
 
 namespace tippe {
 

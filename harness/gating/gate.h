@@ -7,10 +7,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "measure/compare.h"
-#include "records/metric_bounds.h"
-#include "records/records.h"
-#include "scene.h"
+#include "harness/measure/compare.h"
+#include "harness/records/metric_bounds.h"
+#include "harness/records/records.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 

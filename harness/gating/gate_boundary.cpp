@@ -1,5 +1,5 @@
 // Gate checks on boundary searches: reading [[boundary]] tables and judging a search's boundary from its sweep's records.
-#include "gating/gate_boundary.h"
+#include "harness/gating/gate_boundary.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -9,9 +9,9 @@
 
 #include <toml++/toml.h>
 
-#include "io/scene_io.h"
-#include "sweep/sweep_search.h"
-#include "io/toml_reader.h"
+#include "harness/io/scene_io.h"
+#include "harness/sweep/sweep_search.h"
+#include "harness/io/toml_reader.h"
 
 namespace tippe {
 

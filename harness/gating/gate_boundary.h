@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "gating/gate.h"
-#include "sweep/sweep.h"
+#include "harness/gating/gate.h"
+#include "harness/sweep/sweep.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // CI gates: judging one engine's run against its check's bounds, and the verdicts as a table, JUnit XML and JSON.
-#include "gating/gate.h"
+#include "harness/gating/gate.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,10 +7,10 @@
 #include <set>
 #include <sstream>
 
-#include "io/scene_io.h"
-#include "io/text.h"
-#include "records/records.h"
-#include "registry.h"
+#include "harness/io/scene_io.h"
+#include "harness/io/text.h"
+#include "harness/records/records.h"
+#include "engines/core/registry.h"
 
 namespace tippe {
 

@@ -1,8 +1,8 @@
 // Gate files: reading and checking them into checks, and the table of metrics a gate may bound.
-#include "gating/gate.h"
-#include "io/text.h"
+#include "harness/gating/gate.h"
+#include "harness/io/text.h"
 
-#include "registry.h"
+#include "engines/core/registry.h"
 
 #include <algorithm>
 #include <array>
@@ -20,10 +20,10 @@
 
 #include <toml++/toml.h>
 
-#include "records/records.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "io/toml_reader.h"
+#include "harness/records/records.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/io/toml_reader.h"
 
 namespace tippe {
 

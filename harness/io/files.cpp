@@ -1,5 +1,5 @@
 // Whole files: read with a size bound, written and copied atomically.
-#include "io/files.h"
+#include "harness/io/files.h"
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -1,5 +1,5 @@
 // SIGINT, SIGTERM and SIGHUP end a command cleanly: work that leaves files behind stops at its next check and cleans up.
-#include "io/interrupt.h"
+#include "harness/io/interrupt.h"
 
 #include <signal.h>
 #include <string.h>

@@ -1,7 +1,7 @@
 // SIGINT, SIGTERM and SIGHUP end a command cleanly: work that leaves files behind stops at its next check and cleans up.
 #pragma once
 
-#include "stop_request.h"  // Interrupted, and the request the stepping loops poll
+#include "analytic/stop_request.h"  // Interrupted, and the request the stepping loops poll
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // The rules for names and UTF-8 text that reach file names, JSON records and reports.
-#include "io/names.h"
+#include "harness/io/names.h"
 
 #include <algorithm>
 #include <cstddef>

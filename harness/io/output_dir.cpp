@@ -1,5 +1,5 @@
 // An output directory that one tippe command at a time writes, and whose files are replaced as one unit.
-#include "io/output_dir.h"
+#include "harness/io/output_dir.h"
 
 #include <fcntl.h>
 #include <stdio.h>
@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/interrupt.h"
+#include "harness/io/interrupt.h"
 
 namespace tippe {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "io/files.h"
+#include "harness/io/files.h"
 
 namespace tippe {
 

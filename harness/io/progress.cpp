@@ -1,5 +1,5 @@
 // The process-wide progress mode: a terminal gets a redrawn line, anything else whole lines.
-#include "io/progress.h"
+#include "harness/io/progress.h"
 
 #include <unistd.h>
 

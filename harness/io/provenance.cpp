@@ -1,5 +1,5 @@
 // Build provenance compiled into the harness (compiler, flags, commit).
-#include "io/provenance.h"
+#include "harness/io/provenance.h"
 
 namespace tippe {
 

@@ -1,9 +1,9 @@
 // Reading scene files: TOML -> Scene with every key checked (its [engines.*] tables raw), and command-line overrides.
-#include "io/scene_io.h"
-#include "io/hash.h"
-#include "io/text.h"
+#include "harness/io/scene_io.h"
+#include "harness/io/hash.h"
+#include "harness/io/text.h"
 
-#include "io/toml_reader.h"
+#include "harness/io/toml_reader.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -20,8 +20,8 @@
 
 #include <toml++/toml.h>
 
-#include "mass_properties.h"
-#include "io/files.h"
+#include "analytic/mass_properties.h"
+#include "harness/io/files.h"
 
 namespace tippe {
 

@@ -10,8 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/names.h"  // is_valid_name and the UTF-8 rules, which a scene's name and path meet
-#include "scene.h"
+#include "harness/io/names.h"  // is_valid_name and the UTF-8 rules, which a scene's name and path meet
+#include "analytic/scene.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // Scene -> JSON: every field of a scene, its mass properties and engine tables, as run records carry it.
-#include "io/scene_io.h"
+#include "harness/io/scene_io.h"
 
 #include <variant>
 

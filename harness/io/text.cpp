@@ -1,7 +1,7 @@
 // The one escaper for HTML and XML text (report pages, JUnit files).
-#include "io/text.h"
+#include "harness/io/text.h"
 
-#include "io/scene_io.h"
+#include "harness/io/scene_io.h"
 
 namespace tippe {
 

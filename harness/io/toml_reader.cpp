@@ -1,13 +1,13 @@
 // The one checked TOML reader: parsing with line and column in syntax errors, and the typed field checks.
-#include "io/toml_reader.h"
+#include "harness/io/toml_reader.h"
 
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
-#include "io/scene_io.h"
-#include "io/text.h"
-#include "io/files.h"
+#include "harness/io/scene_io.h"
+#include "harness/io/text.h"
+#include "harness/io/files.h"
 
 namespace tippe {
 

@@ -1,9 +1,9 @@
 // Every column of a run's trajectory.csv kept as numbers in memory: the library's and the Python module's trajectories, without text.
 #pragma once
 
-#include <tippe/tippe.h>
+#include "include/tippe/tippe.h"
 
-#include "records/records.h"
+#include "harness/records/records.h"
 
 namespace tippe {
 

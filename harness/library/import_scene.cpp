@@ -6,12 +6,12 @@
 #include <locale>
 #include <sstream>
 
-#include "io/output_dir.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "library/verbs.h"
-#include "mujoco_api.h"
-#include "settings.h"
+#include "harness/io/output_dir.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/library/verbs.h"
+#include "engines/mujoco/mujoco_api.h"
+#include "engines/core/settings.h"
 
 namespace tippe {
 

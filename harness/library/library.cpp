@@ -1,15 +1,15 @@
 // The one-call entry points of <tippe/tippe.h>: a scene in, the reference's run summary out.
-#include <tippe/tippe.h>
+#include "include/tippe/tippe.h"
 
 #include <cmath>
 #include <limits>
 #include <sstream>
 
-#include "library/columns.h"
-#include "records/records.h"
-#include "measure/run.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "harness/library/columns.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 

@@ -1,22 +1,22 @@
 // The command line's compare and gate runs, the registry and advice as JSON, as functions the `tippe` command and the Python module share.
-#include "library/verbs.h"
+#include "harness/library/verbs.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <map>
 #include <thread>
 
-#include "io/interrupt.h"
-#include "io/output_dir.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "records/records.h"
-#include "records/sweep_record.h"
-#include "registry.h"
-#include "report/report.h"
-#include "report/sweep_analysis.h"
-#include "sweep/sweep.h"
-#include "sweep/sweep_search.h"
+#include "harness/io/interrupt.h"
+#include "harness/io/output_dir.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/records/records.h"
+#include "harness/records/sweep_record.h"
+#include "engines/core/registry.h"
+#include "harness/report/report.h"
+#include "harness/report/sweep_analysis.h"
+#include "harness/sweep/sweep.h"
+#include "harness/sweep/sweep_search.h"
 
 namespace tippe {
 

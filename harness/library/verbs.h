@@ -12,16 +12,16 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
-#include <tippe/tippe.h>
+#include "include/tippe/tippe.h"
 
-#include "advise/advise.h"
-#include "gating/gate.h"
-#include "gating/gate_boundary.h"
-#include "library/columns.h"
-#include "measure/compare.h"
-#include "mujoco_import.h"
-#include "records/trajectory.h"
-#include "simulator.h"
+#include "harness/advise/advise.h"
+#include "harness/gating/gate.h"
+#include "harness/gating/gate_boundary.h"
+#include "harness/library/columns.h"
+#include "harness/measure/compare.h"
+#include "engines/mujoco/mujoco_import.h"
+#include "harness/records/trajectory.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // Classification of one finished run: ok, or what went wrong first (diverged, unphysical, clamped, failed, contact_lost) and when.
-#include "measure/classify.h"
+#include "harness/measure/classify.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <sstream>
 #include <vector>
 
-#include "fixed_step.h"
+#include "engines/core/fixed_step.h"
 
 namespace tippe {
 

@@ -4,9 +4,9 @@
 #include <limits>
 #include <string>
 
-#include "measure/compare.h"
-#include "records/records.h"
-#include "scene.h"
+#include "harness/measure/compare.h"
+#include "harness/records/records.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 

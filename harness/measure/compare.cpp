@@ -1,5 +1,5 @@
 // Side-by-side runs of the reference and engines on one scene: each on its worker, the reference cached and self-checked.
-#include "measure/compare.h"
+#include "harness/measure/compare.h"
 
 #include <algorithm>
 #include <array>
@@ -20,14 +20,14 @@
 #include <stdexcept>
 #include <unistd.h>
 
-#include "adapters.h"
-#include "io/interrupt.h"
-#include "io/text.h"
-#include "io/progress.h"
-#include "io/provenance.h"
-#include "io/scene_io.h"
-#include "measure/task_farm.h"
-#include "measure/run.h"
+#include "engines/core/adapters.h"
+#include "harness/io/interrupt.h"
+#include "harness/io/text.h"
+#include "harness/io/progress.h"
+#include "harness/io/provenance.h"
+#include "harness/io/scene_io.h"
+#include "harness/measure/task_farm.h"
+#include "harness/measure/run.h"
 
 namespace tippe {
 

@@ -6,13 +6,13 @@
 #include <string>
 #include <vector>
 
-#include "measure/metrics.h"
-#include "measure/reference_cache.h"
-#include "measure/self_check.h"
-#include "records/comparison.h"
-#include "records/trajectory.h"
-#include "registry.h"
-#include "scene.h"
+#include "harness/measure/metrics.h"
+#include "harness/measure/reference_cache.h"
+#include "harness/measure/self_check.h"
+#include "harness/records/comparison.h"
+#include "harness/records/trajectory.h"
+#include "engines/core/registry.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 

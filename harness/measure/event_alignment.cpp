@@ -1,5 +1,5 @@
 // Canonical event sequences and their edit-distance alignment (the vocabulary and its reasons are in the header).
-#include "measure/event_alignment.h"
+#include "harness/measure/event_alignment.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,13 +1,13 @@
 // The metrics of one engine's run against the reference, a pure function of two trajectories and their records.
-#include "measure/metrics.h"
+#include "harness/measure/metrics.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
 #include <limits>
-#include "io/json_fields.h"
-#include "measure/event_alignment.h"
+#include "harness/io/json_fields.h"
+#include "harness/measure/event_alignment.h"
 
 namespace tippe {
 

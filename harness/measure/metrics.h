@@ -4,9 +4,9 @@
 #include <limits>
 #include <optional>
 #include <vector>
-#include "records/comparison.h"
-#include "records/trajectory.h"
-#include "scene.h"
+#include "harness/records/comparison.h"
+#include "harness/records/trajectory.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 

@@ -1,12 +1,12 @@
 // The reference cache: a reference run and its self-check stored and accepted only for the same physics and build.
-#include "measure/reference_cache.h"
+#include "harness/measure/reference_cache.h"
 
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
-#include "io/provenance.h"
-#include "records/records.h"
-#include "registry.h"
+#include "harness/io/provenance.h"
+#include "harness/records/records.h"
+#include "engines/core/registry.h"
 
 namespace tippe {
 

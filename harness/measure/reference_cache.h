@@ -4,10 +4,10 @@
 #include <filesystem>
 #include <optional>
 #include <string>
-#include "records/comparison.h"
-#include "records/trajectory.h"
-#include "scene.h"
-#include "measure/self_check.h"
+#include "harness/records/comparison.h"
+#include "harness/records/trajectory.h"
+#include "analytic/scene.h"
+#include "harness/measure/self_check.h"
 
 namespace tippe {
 

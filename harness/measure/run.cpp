@@ -1,5 +1,5 @@
 // Running one simulator on a scene into a run record, sample by sample.
-#include "measure/run.h"
+#include "harness/measure/run.h"
 
 #include <cmath>
 #include <cstddef>
@@ -7,10 +7,10 @@
 #include <utility>
 #include <vector>
 
-#include "mass_properties.h"
-#include "io/interrupt.h"
-#include "io/scene_io.h"
-#include "timing.h"
+#include "analytic/mass_properties.h"
+#include "harness/io/interrupt.h"
+#include "harness/io/scene_io.h"
+#include "engines/core/timing.h"
 
 namespace tippe {
 

@@ -4,9 +4,9 @@
 #include <functional>
 #include <string>
 
-#include "records/records.h"
-#include "scene.h"
-#include "simulator.h"
+#include "harness/records/records.h"
+#include "analytic/scene.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

@@ -1,15 +1,15 @@
 // The reference's self-check: the second method, where two reference runs part, and running the second one.
-#include "measure/self_check.h"
+#include "harness/measure/self_check.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include "io/json_fields.h"
-#include "records/records.h"
-#include "measure/run.h"
-#include "registry.h"
+#include "harness/io/json_fields.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "engines/core/registry.h"
 
 namespace tippe {
 

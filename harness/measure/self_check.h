@@ -3,9 +3,9 @@
 
 #include <optional>
 #include <string>
-#include "records/comparison.h"
-#include "records/trajectory.h"
-#include "scene.h"
+#include "harness/records/comparison.h"
+#include "harness/records/trajectory.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 

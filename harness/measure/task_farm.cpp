@@ -1,5 +1,5 @@
 // Tasks on threads of one process: the local TaskFarm, and the thread pool under it.
-#include "measure/task_farm.h"
+#include "harness/measure/task_farm.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,5 +1,5 @@
 // The comparison record: writing comparison.json and reading it back as checked input; the physics hash.
-#include "records/comparison.h"
+#include "harness/records/comparison.h"
 
 #include <cmath>
 #include <filesystem>
@@ -8,9 +8,9 @@
 #include <tuple>
 #include <utility>
 #include <stdexcept>
-#include "io/json_fields.h"
-#include "io/scene_io.h"
-#include "registry.h"
+#include "harness/io/json_fields.h"
+#include "harness/io/scene_io.h"
+#include "engines/core/registry.h"
 
 namespace tippe {
 

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 #include <nlohmann/json.hpp>
-#include "io/provenance.h"
-#include "records/records.h"
-#include "scene.h"
+#include "harness/io/provenance.h"
+#include "harness/records/records.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 

@@ -22,8 +22,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/json_fields.h"
-#include "simulator.h"
+#include "harness/io/json_fields.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // The metrics a bound may name, read from a Metrics record, and bounds parsed from text.
-#include "records/metric_bounds.h"
+#include "harness/records/metric_bounds.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -7,8 +7,8 @@
 #include <type_traits>
 #include <utility>
 
-#include "io/scene_io.h"
-#include "io/text.h"
+#include "harness/io/scene_io.h"
+#include "harness/io/text.h"
 
 namespace tippe {
 

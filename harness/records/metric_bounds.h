@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "records/comparison.h"
+#include "harness/records/comparison.h"
 
 namespace tippe {
 

@@ -1,13 +1,13 @@
 // The record schemas (schemas/run-summary.schema.json, comparison.schema.json): a fixed frame per record, its fields' properties from their `visit`.
-#include "records/record_schemas.h"
+#include "harness/records/record_schemas.h"
 
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
-#include "records/comparison.h"
-#include "records/fields.h"
-#include "records/records.h"
+#include "harness/records/comparison.h"
+#include "harness/records/fields.h"
+#include "harness/records/records.h"
 
 namespace tippe {
 

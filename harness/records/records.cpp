@@ -1,6 +1,6 @@
 // Run records: their summary numbers, JSON and CSV writers, atomic files.
-#include "records/records.h"
-#include "io/json_fields.h"
+#include "harness/records/records.h"
+#include "harness/io/json_fields.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -21,8 +21,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "io/g17.h"
-#include "io/provenance.h"
+#include "harness/io/g17.h"
+#include "harness/io/provenance.h"
 
 namespace tippe {
 

@@ -13,10 +13,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/files.h"
-#include "records/fields.h"
-#include "scene.h"
-#include "simulator.h"
+#include "harness/io/files.h"
+#include "harness/records/fields.h"
+#include "analytic/scene.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 

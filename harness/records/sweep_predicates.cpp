@@ -1,5 +1,5 @@
 // The predicates on a sweep record that its readers share (regime, ladder direction, axis text) and a search's criterion.
-#include "records/sweep_record.h"
+#include "harness/records/sweep_record.h"
 
 #include <cmath>
 #include <cstdio>
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/text.h"
+#include "harness/io/text.h"
 
 namespace tippe {
 

@@ -1,7 +1,7 @@
 // The sweep record (one line of records.jsonl) and sweep.json: writing them, and reading them back as checked input.
-#include "records/sweep_record.h"
-#include "io/json_fields.h"
-#include "io/text.h"
+#include "harness/records/sweep_record.h"
+#include "harness/io/json_fields.h"
+#include "harness/io/text.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -15,8 +15,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "io/scene_io.h"
-#include "records/records.h"
+#include "harness/io/scene_io.h"
+#include "harness/records/records.h"
 
 namespace tippe {
 

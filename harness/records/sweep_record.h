@@ -11,8 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "records/comparison.h"
-#include "records/metric_bounds.h"
+#include "harness/records/comparison.h"
+#include "harness/records/metric_bounds.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // A run's sampled trajectory in memory: filled from observations or from a trajectory.csv.
-#include "records/trajectory.h"
+#include "harness/records/trajectory.h"
 
 #include <cmath>
 #include <filesystem>

@@ -3,7 +3,7 @@
 
 #include <string>
 #include <vector>
-#include "records/records.h"
+#include "harness/records/records.h"
 
 namespace tippe {
 

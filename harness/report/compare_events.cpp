@@ -1,9 +1,9 @@
 // The event-sequence section of the comparison report: the alignment's counts per engine and the aligned sequences.
-#include "report/compare_events.h"
+#include "harness/report/compare_events.h"
 
 #include <string>
 
-#include "report/report_text.h"
+#include "harness/report/report_text.h"
 
 namespace tippe {
 

@@ -1,13 +1,13 @@
 // The energy-ledger section of the comparison report: each run's account of its energy and the dominant cause of an engine's loss.
-#include "report/compare_ledger.h"
+#include "harness/report/compare_ledger.h"
 
 #include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "report/ledger_chart.h"
-#include "report/report_text.h"
+#include "harness/report/ledger_chart.h"
+#include "harness/report/report_text.h"
 
 namespace tippe {
 

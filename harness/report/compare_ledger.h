@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "report/document.h"
+#include "harness/report/document.h"
 
 namespace tippe {
 

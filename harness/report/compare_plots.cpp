@@ -6,11 +6,11 @@
 #include <map>
 #include <utility>
 
-#include "measure/compare.h"
-#include "records/records.h"
-#include "report/gnuplot.h"
-#include "report/report.h"
-#include "report/report_text.h"
+#include "harness/measure/compare.h"
+#include "harness/records/records.h"
+#include "harness/report/gnuplot.h"
+#include "harness/report/report.h"
+#include "harness/report/report_text.h"
 
 namespace tippe {
 

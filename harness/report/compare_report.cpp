@@ -1,5 +1,5 @@
 // The comparison report: the verdict, tables, findings and the page as one document, from comparison.json alone.
-#include "report/report.h"
+#include "harness/report/report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,12 +10,12 @@
 #include <sstream>
 #include <utility>
 
-#include "measure/compare.h"
-#include "records/records.h"
-#include "report/compare_events.h"
-#include "report/compare_ledger.h"
-#include "report/ledger_chart.h"
-#include "report/report_text.h"
+#include "harness/measure/compare.h"
+#include "harness/records/records.h"
+#include "harness/report/compare_events.h"
+#include "harness/report/compare_ledger.h"
+#include "harness/report/ledger_chart.h"
+#include "harness/report/report_text.h"
 
 namespace tippe {
 

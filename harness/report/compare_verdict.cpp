@@ -1,12 +1,12 @@
 // The comparison's verdict in words: one sentence per engine against the reference, and the one-line summary `tippe compare` prints.
-#include "report/report.h"
+#include "harness/report/report.h"
 
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "report/compare_ledger.h"
-#include "report/report_text.h"
+#include "harness/report/compare_ledger.h"
+#include "harness/report/report_text.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // One document model for every report page, rendered to Markdown and to one self-contained HTML page.
-#include "report/document.h"
+#include "harness/report/document.h"
 
 #include <cctype>
 #include <sstream>

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "io/text.h"
+#include "harness/io/text.h"
 
 namespace tippe {
 

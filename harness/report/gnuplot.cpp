@@ -1,7 +1,7 @@
 // The one gnuplot writer: scripts from the program's own text, data only in .dat files, run without a shell.
-#include "report/gnuplot.h"
+#include "harness/report/gnuplot.h"
 
-#include "registry.h"
+#include "engines/core/registry.h"
 
 #include <fcntl.h>
 #include <spawn.h>

@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
-#include "report/report.h"
-#include "report/report_text.h"
-#include "report/sweep_groups.h"
+#include "harness/report/report.h"
+#include "harness/report/report_text.h"
+#include "harness/report/sweep_groups.h"
 
 namespace tippe {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "report/report.h"
-#include "report/report_text.h"
+#include "harness/report/report.h"
+#include "harness/report/report_text.h"
 
 namespace tippe {
 

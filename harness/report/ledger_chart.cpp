@@ -1,12 +1,12 @@
 // The energy ledger as a chart: one stacked bar per run (the reference's first), each term of its account / |E0|.
-#include "report/ledger_chart.h"
+#include "harness/report/ledger_chart.h"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "report/report_text.h"
+#include "harness/report/report_text.h"
 
 namespace tippe {
 

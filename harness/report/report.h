@@ -6,8 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "records/sweep_record.h"
-#include "report/document.h"
+#include "harness/records/sweep_record.h"
+#include "harness/report/document.h"
 
 namespace tippe {
 

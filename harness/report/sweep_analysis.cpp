@@ -14,11 +14,11 @@
 #include <tuple>
 #include <vector>
 
-#include "registry.h"
-#include "records/records.h"
-#include "report/sweep_analysis.h"
-#include "report/sweep_groups.h"
-#include "sweep/sweep_search.h"
+#include "engines/core/registry.h"
+#include "harness/records/records.h"
+#include "harness/report/sweep_analysis.h"
+#include "harness/report/sweep_groups.h"
+#include "harness/sweep/sweep_search.h"
 
 namespace tippe {
 

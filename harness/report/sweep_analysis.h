@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "records/sweep_record.h"
+#include "harness/records/sweep_record.h"
 
 namespace tippe {
 

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "records/records.h"
-#include "registry.h"
-#include "report/gnuplot.h"
-#include "report/sweep_groups.h"
+#include "harness/records/records.h"
+#include "engines/core/registry.h"
+#include "harness/report/gnuplot.h"
+#include "harness/report/sweep_groups.h"
 
 namespace tippe::sweep_report_detail {
 

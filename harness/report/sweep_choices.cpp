@@ -1,12 +1,12 @@
 // The sweep report's "Modelling choices" section: which choice axes move each engine's verdict on each scene.
-#include "report/sweep_choices.h"
+#include "harness/report/sweep_choices.h"
 
 #include <algorithm>
 #include <string>
 #include <vector>
 
-#include "report/sweep_analysis.h"
-#include "report/sweep_groups.h"
+#include "harness/report/sweep_analysis.h"
+#include "harness/report/sweep_groups.h"
 
 namespace tippe {
 

@@ -3,8 +3,8 @@
 
 #include <vector>
 
-#include "records/sweep_record.h"
-#include "report/document.h"
+#include "harness/records/sweep_record.h"
+#include "harness/report/document.h"
 
 namespace tippe {
 

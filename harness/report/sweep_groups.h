@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sweep/sweep.h"
+#include "harness/sweep/sweep.h"
 
 namespace tippe::sweep_report_detail {
 

@@ -15,16 +15,16 @@
 #include <tuple>
 #include <vector>
 
-#include "registry.h"
-#include "report/gnuplot.h"
-#include "records/records.h"
-#include "report/report.h"
-#include "sweep/sweep.h"
-#include "report/document.h"
-#include "report/sweep_groups.h"
-#include "sweep/sweep_search.h"
-#include "report/sweep_analysis.h"
-#include "report/sweep_choices.h"
+#include "engines/core/registry.h"
+#include "harness/report/gnuplot.h"
+#include "harness/records/records.h"
+#include "harness/report/report.h"
+#include "harness/sweep/sweep.h"
+#include "harness/report/document.h"
+#include "harness/report/sweep_groups.h"
+#include "harness/sweep/sweep_search.h"
+#include "harness/report/sweep_analysis.h"
+#include "harness/report/sweep_choices.h"
 
 namespace tippe {
 

@@ -6,7 +6,7 @@
 #include <set>
 #include <tuple>
 
-#include "sweep/sweep_search.h"
+#include "harness/sweep/sweep_search.h"
 
 namespace tippe {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "report/sweep_groups.h"
-#include "report/sweep_analysis.h"
+#include "harness/report/sweep_groups.h"
+#include "harness/report/sweep_analysis.h"
 
 namespace tippe::sweep_report_detail {
 

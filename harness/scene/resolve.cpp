@@ -1,14 +1,14 @@
 // A scene's resolve step: engines' files read and hashed, [engines.*] checked through the registry, the reference's settings applied.
-#include "scene/resolve.h"
+#include "harness/scene/resolve.h"
 
 #include <set>
 #include <stdexcept>
 #include <utility>
 #include <variant>
 
-#include "adapters.h"
-#include "io/files.h"
-#include "registry.h"
+#include "engines/core/adapters.h"
+#include "harness/io/files.h"
+#include "engines/core/registry.h"
 
 namespace tippe {
 

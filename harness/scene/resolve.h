@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "io/scene_io.h"
-#include "scene.h"
+#include "harness/io/scene_io.h"
+#include "analytic/scene.h"
 
 namespace tippe {
 

@@ -1,5 +1,5 @@
 // Tasks over MPI ranks: rank 0 hands out task indices one at a time as workers ask, and receives every result.
-#include "sweep/mpi_farm.h"
+#include "harness/sweep/mpi_farm.h"
 
 #include <mpi.h>
 

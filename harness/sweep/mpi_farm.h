@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "measure/task_farm.h"
+#include "harness/measure/task_farm.h"
 
 namespace tippe {
 

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "io/hash.h"
-#include "records/sweep_record.h"
-#include "scene.h"
-#include "measure/task_farm.h"
+#include "harness/io/hash.h"
+#include "harness/records/sweep_record.h"
+#include "analytic/scene.h"
+#include "harness/measure/task_farm.h"
 
 namespace tippe {
 

@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "measure/compare.h"
-#include "sweep/sweep.h"
+#include "harness/measure/compare.h"
+#include "harness/sweep/sweep.h"
 
 namespace tippe::sweep_detail {
 

@@ -1,7 +1,7 @@
 // Sweep files: reading a sweep file into a checked plan of points, and the points' stable ids.
-#include "sweep/sweep.h"
-#include "io/hash.h"
-#include "io/text.h"
+#include "harness/sweep/sweep.h"
+#include "harness/io/hash.h"
+#include "harness/io/text.h"
 
 #include <toml++/toml.h>
 
@@ -15,11 +15,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "io/toml_reader.h"
-#include "registry.h"
-#include "sweep/sweep_search.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/io/toml_reader.h"
+#include "engines/core/registry.h"
+#include "harness/sweep/sweep_search.h"
 
 namespace tippe {
 

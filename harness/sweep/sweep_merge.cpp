@@ -8,12 +8,12 @@
 #include <sstream>
 #include <tuple>
 
-#include "io/interrupt.h"
-#include "io/output_dir.h"
-#include "io/provenance.h"
-#include "records/records.h"
-#include "io/scene_io.h"
-#include "sweep/sweep.h"
+#include "harness/io/interrupt.h"
+#include "harness/io/output_dir.h"
+#include "harness/io/provenance.h"
+#include "harness/records/records.h"
+#include "harness/io/scene_io.h"
+#include "harness/sweep/sweep.h"
 
 namespace tippe {
 

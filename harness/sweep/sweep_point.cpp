@@ -1,18 +1,18 @@
 // One point of a sweep: the engine's run(s) at the point's settings, compared with the scene's reference into a record.
-#include "sweep/sweep_detail.h"
+#include "harness/sweep/sweep_detail.h"
 
 #include <cmath>
 #include <exception>
 #include <limits>
 #include <memory>
 
-#include "registry.h"
-#include "io/interrupt.h"
-#include "io/text.h"
-#include "io/provenance.h"
-#include "measure/classify.h"
-#include "records/records.h"
-#include "measure/run.h"
+#include "engines/core/registry.h"
+#include "harness/io/interrupt.h"
+#include "harness/io/text.h"
+#include "harness/io/provenance.h"
+#include "harness/measure/classify.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
 
 namespace tippe::sweep_detail {
 

@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "io/progress.h"
-#include "sweep/sweep_detail.h"
+#include "harness/io/progress.h"
+#include "harness/sweep/sweep_detail.h"
 
 namespace tippe::sweep_detail {
 

@@ -1,17 +1,17 @@
 // The reference of each scene of a sweep (or its self-check alone): computed once on any rank, cached in OUT/reference/, shared with every rank.
-#include "sweep/sweep_detail.h"
+#include "harness/sweep/sweep_detail.h"
 
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
 
-#include "registry.h"
-#include "measure/classify.h"
-#include "io/interrupt.h"
-#include "io/json_fields.h"
-#include "io/text.h"
-#include "records/records.h"
-#include "measure/run.h"
+#include "engines/core/registry.h"
+#include "harness/measure/classify.h"
+#include "harness/io/interrupt.h"
+#include "harness/io/json_fields.h"
+#include "harness/io/text.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
 
 namespace tippe::sweep_detail {
 

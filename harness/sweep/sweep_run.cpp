@@ -1,5 +1,5 @@
 // Running a sweep: deciding what runs from OUT, the references, the points on a task farm, shards and the MPI messages.
-#include "sweep/sweep.h"
+#include "harness/sweep/sweep.h"
 
 #include <algorithm>
 #include <chrono>
@@ -12,16 +12,16 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "io/append_file.h"
-#include "io/interrupt.h"
-#include "io/output_dir.h"
-#include "io/progress.h"
-#include "io/provenance.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "records/records.h"
-#include "sweep/sweep_detail.h"
-#include "sweep/sweep_progress.h"
+#include "harness/io/append_file.h"
+#include "harness/io/interrupt.h"
+#include "harness/io/output_dir.h"
+#include "harness/io/progress.h"
+#include "harness/io/provenance.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/records/records.h"
+#include "harness/sweep/sweep_detail.h"
+#include "harness/sweep/sweep_progress.h"
 
 namespace tippe {
 

@@ -1,6 +1,6 @@
 // Boundary searches in sweeps: `ladder.search` read from a sweep file, the bisection replayed from records, the plan's waves, and the boundaries found.
-#include "sweep/sweep_search.h"
-#include "io/text.h"
+#include "harness/sweep/sweep_search.h"
+#include "harness/io/text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,9 +14,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "io/toml_reader.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/io/toml_reader.h"
 
 namespace tippe {
 

@@ -8,7 +8,7 @@
 
 #include <toml++/toml.h>
 
-#include "sweep/sweep.h"
+#include "harness/sweep/sweep.h"
 
 namespace tippe {
 

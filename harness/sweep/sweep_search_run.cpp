@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "sweep/sweep_search.h"
+#include "harness/sweep/sweep_search.h"
 
 namespace tippe {
 

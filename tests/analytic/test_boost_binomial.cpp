@@ -1,5 +1,5 @@
 // The table-once binomial coefficient (analytic/boost_binomial.h) gives exactly the doubles of Boost's own formula.
-#include "boost_binomial.h"  // first, as in the reference model
+#include "analytic/boost_binomial.h"  // first, as in the reference model
 
 #include <gtest/gtest.h>
 

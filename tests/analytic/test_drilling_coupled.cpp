@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "support/fixtures.h"
-#include "support/reference_runs.h"
-#include "simulator.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/reference_runs.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 namespace {

@@ -7,10 +7,10 @@
 #include <random>
 #include <string>
 
-#include "contact_dynamics.h"
-#include "reference_model.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "analytic/contact_dynamics.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 namespace {

@@ -6,11 +6,11 @@
 #include <optional>
 #include <string>
 
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
-#include "observables.h"
-#include "support/fixtures.h"
-#include "support/reference_runs.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "analytic/observables.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/reference_runs.h"
 
 namespace tippe {
 namespace {

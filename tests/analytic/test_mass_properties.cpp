@@ -20,7 +20,7 @@
 
 #include <unistd.h>
 
-#include "mass_properties.h"
+#include "analytic/mass_properties.h"
 
 namespace tippe {
 namespace {

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <optional>
 
-#include "../analytic/initial_state.h"
-#include "../analytic/reference_model.h"
+#include "analytic/initial_state.h"
+#include "analytic/reference_model.h"
 
 namespace tippe {
 namespace {

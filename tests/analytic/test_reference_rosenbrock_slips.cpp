@@ -1,8 +1,8 @@
 // rosenbrock4 through the slip starts that made it stall, against Bulirsch-Stoer. A program of its own, labelled slow: Rosenbrock runs ~100 times slower under the sanitizers.
 #include <gtest/gtest.h>
 
-#include "support/fixtures.h"
-#include "support/reference_runs.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/reference_runs.h"
 
 namespace tippe {
 namespace {

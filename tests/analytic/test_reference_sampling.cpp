@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <string>
 
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "measure/run.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/measure/run.h"
 
 namespace tippe {
 namespace {

@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "initial_state.h"
-#include "reference_model.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "support/fixtures.h"
-#include "support/reference_runs.h"
+#include "analytic/initial_state.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/reference_runs.h"
 
 namespace tippe {
 namespace {

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/initial_state.h"
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "analytic/initial_state.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 namespace {

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 namespace {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <optional>
 
-#include "../analytic/initial_state.h"
-#include "../analytic/reference_model.h"
+#include "analytic/initial_state.h"
+#include "analytic/reference_model.h"
 
 namespace tippe {
 namespace {

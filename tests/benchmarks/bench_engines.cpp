@@ -1,10 +1,10 @@
 // Google Benchmark: step cost of each engine on the toy scene, and the adapter's overhead.
 #include <benchmark/benchmark.h>
 
-#include "fixed_step.h"
-#include "registry.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "engines/core/fixed_step.h"
+#include "engines/core/registry.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 

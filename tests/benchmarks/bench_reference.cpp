@@ -3,11 +3,11 @@
 
 #include <sys/resource.h>
 
-#include "../../analytic/contact_dynamics.h"
-#include "../../analytic/initial_state.h"
-#include "../../analytic/reference_model.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "analytic/contact_dynamics.h"
+#include "analytic/initial_state.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 namespace {

@@ -8,14 +8,14 @@
 #include <string>
 #include <thread>
 
-#include "adapters.h"
-#include "bullet_sim.h"
-#include "initial_state.h"
-#include "observables.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "simulator.h"
-#include "support/fixtures.h"
+#include "engines/core/adapters.h"
+#include "engines/bullet/bullet_sim.h"
+#include "analytic/initial_state.h"
+#include "analytic/observables.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "engines/core/simulator.h"
+#include "tests/support/fixtures.h"
 
 namespace tippe {
 namespace {

@@ -10,12 +10,12 @@
 #include <set>
 #include <sstream>
 
-#include "../analytic/contact_dynamics.h"
-#include "../analytic/initial_state.h"
-#include "records/records.h"
-#include "measure/run.h"
-#include "registry.h"
-#include "support/fixtures.h"
+#include "analytic/contact_dynamics.h"
+#include "analytic/initial_state.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "engines/core/registry.h"
+#include "tests/support/fixtures.h"
 
 namespace tippe {
 namespace {

@@ -6,12 +6,12 @@
 #include <cstdio>
 #include <string>
 
-#include "bench_friction.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "registry.h"
-#include "simulator.h"
-#include "support/fixtures.h"
+#include "engines/core/bench_friction.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "engines/core/registry.h"
+#include "engines/core/simulator.h"
+#include "tests/support/fixtures.h"
 
 namespace tippe {
 namespace {

@@ -8,14 +8,14 @@
 #include <string>
 #include <vector>
 
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "measure/run.h"
-#include "records/trajectory.h"
-#include "registry.h"
-#include "simulator.h"
-#include "support/fixtures.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/measure/run.h"
+#include "harness/records/trajectory.h"
+#include "engines/core/registry.h"
+#include "engines/core/simulator.h"
+#include "tests/support/fixtures.h"
 
 namespace tippe {
 namespace {

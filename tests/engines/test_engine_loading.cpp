@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "fixed_step.h"
-#include "mujoco_api.h"
-#include "registry.h"
-#include "step_checks.h"
-#include "support/process.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "engines/core/fixed_step.h"
+#include "engines/mujoco/mujoco_api.h"
+#include "engines/core/registry.h"
+#include "engines/core/step_checks.h"
+#include "tests/support/process.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace {
 

@@ -9,14 +9,14 @@
 #include <optional>
 #include <string>
 
-#include "../analytic/initial_state.h"
-#include "../analytic/reference_model.h"
-#include "adapters.h"
-#include "registry.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "simulator.h"
-#include "support/reference_runs.h"
+#include "analytic/initial_state.h"
+#include "analytic/reference_model.h"
+#include "engines/core/adapters.h"
+#include "engines/core/registry.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "engines/core/simulator.h"
+#include "tests/support/reference_runs.h"
 
 namespace tippe {
 namespace {

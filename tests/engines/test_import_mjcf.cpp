@@ -19,15 +19,15 @@
 #include <string>
 #include <vector>
 
-#include "initial_state.h"
-#include "mujoco_import.h"
-#include "mujoco_sim.h"
-#include "records/records.h"
-#include "measure/run.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "simulator.h"
-#include "support/process.h"
+#include "analytic/initial_state.h"
+#include "engines/mujoco/mujoco_import.h"
+#include "engines/mujoco/mujoco_sim.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "engines/core/simulator.h"
+#include "tests/support/process.h"
 
 namespace tippe {
 namespace {

@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "adapters.h"
-#include "bullet_sim.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "engines/core/adapters.h"
+#include "engines/bullet/bullet_sim.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 namespace {

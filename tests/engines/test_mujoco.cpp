@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
-#include "adapters.h"
-#include "initial_state.h"
-#include "mujoco_sim.h"
-#include "observables.h"
-#include "simulator.h"
-#include "support/fixtures.h"
+#include "engines/core/adapters.h"
+#include "analytic/initial_state.h"
+#include "engines/mujoco/mujoco_sim.h"
+#include "analytic/observables.h"
+#include "engines/core/simulator.h"
+#include "tests/support/fixtures.h"
 
 namespace tippe {
 namespace {

@@ -21,11 +21,11 @@
 #include <string>
 #include <vector>
 
-#include "adapters.h"
-#include "mujoco_sim.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "simulator.h"
+#include "engines/core/adapters.h"
+#include "engines/mujoco/mujoco_sim.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "engines/core/simulator.h"
 
 namespace tippe {
 namespace {

@@ -8,12 +8,12 @@
 #include <string>
 #include <thread>
 
-#include "adapters.h"
-#include "initial_state.h"
-#include "observables.h"
-#include "ode_sim.h"
-#include "simulator.h"
-#include "support/fixtures.h"
+#include "engines/core/adapters.h"
+#include "analytic/initial_state.h"
+#include "analytic/observables.h"
+#include "engines/ode/ode_sim.h"
+#include "engines/core/simulator.h"
+#include "tests/support/fixtures.h"
 
 namespace tippe {
 namespace {

@@ -7,11 +7,11 @@
 #include <utility>
 #include <vector>
 
-#include "records/records.h"
-#include "measure/run.h"
-#include "registry.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "engines/core/registry.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 namespace {

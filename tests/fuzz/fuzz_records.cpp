@@ -9,8 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "measure/compare.h"
-#include "records/records.h"
+#include "harness/measure/compare.h"
+#include "harness/records/records.h"
 
 namespace {
 

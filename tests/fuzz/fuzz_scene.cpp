@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace {
 

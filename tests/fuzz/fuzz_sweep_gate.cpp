@@ -10,9 +10,9 @@
 #include <fstream>
 #include <string>
 
-#include "gating/gate.h"
-#include "io/scene_io.h"
-#include "sweep/sweep.h"
+#include "harness/gating/gate.h"
+#include "harness/io/scene_io.h"
+#include "harness/sweep/sweep.h"
 
 namespace fs = std::filesystem;
 

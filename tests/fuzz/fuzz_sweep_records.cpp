@@ -6,8 +6,8 @@
 #include <exception>
 #include <string>
 
-#include "sweep/sweep.h"
-#include "report/sweep_analysis.h"
+#include "harness/sweep/sweep.h"
+#include "harness/report/sweep_analysis.h"
 
 namespace {
 

@@ -6,7 +6,7 @@ execute_process(COMMAND ${CMAKE_COMMAND} --install ${BINARY_DIR} --prefix ${PREF
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "cmake --install ${BINARY_DIR} --prefix ${PREFIX} failed (${rc})")
 endif()
-foreach(f include/tippe/tippe.h include/tippe/analytic/scene.h include/tippe/engines/simulator.h
+foreach(f include/tippe/tippe.h include/tippe/analytic/scene.h include/tippe/engines/core/simulator.h
           lib/cmake/tippe/tippeConfig.cmake lib/cmake/tippe/tippeConfigVersion.cmake lib/pkgconfig/tippe.pc)
   if(NOT EXISTS ${PREFIX}/${f})
     message(FATAL_ERROR "the installed tree has no ${f}")

@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "reference_model.h"
-#include "scene.h"
-#include "simulator.h"
-#include "support/files.h"
-#include "support/process.h"
-#include "support/records.h"
+#include "analytic/reference_model.h"
+#include "analytic/scene.h"
+#include "engines/core/simulator.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
+#include "tests/support/records.h"
 
 namespace tippe::fixtures {
 

@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "initial_state.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "observables.h"
-#include "reference_model.h"
+#include "analytic/initial_state.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "analytic/observables.h"
+#include "analytic/reference_model.h"
 
 namespace tippe::fixtures {
 

@@ -4,7 +4,7 @@
 #include <optional>
 #include <string>
 
-#include "records/sweep_record.h"
+#include "harness/records/sweep_record.h"
 
 namespace tippe::fixtures {
 

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "support/fixtures.h"
-#include "support/process.h"
-#include "support/records.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/process.h"
+#include "tests/support/records.h"
 
 namespace tippe::sweep_runs {
 

@@ -18,9 +18,9 @@
 #include <thread>
 #include <vector>
 
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "registry.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "engines/core/registry.h"
 
 namespace tippe {
 namespace {

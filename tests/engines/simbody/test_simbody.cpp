@@ -5,8 +5,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "registry.h"
-#include "support/fixtures.h"
+#include "engines/core/registry.h"
+#include "tests/support/fixtures.h"
 
 namespace tippe {
 namespace {

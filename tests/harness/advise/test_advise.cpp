@@ -7,14 +7,14 @@
 #include <string>
 #include <vector>
 
-#include "advise/advise.h"
-#include "gating/gate_boundary.h"
-#include "registry.h"
-#include "report/sweep_analysis.h"
-#include "support/files.h"
-#include "support/fixtures.h"
-#include "support/process.h"
-#include "sweep/sweep_search.h"
+#include "harness/advise/advise.h"
+#include "harness/gating/gate_boundary.h"
+#include "engines/core/registry.h"
+#include "harness/report/sweep_analysis.h"
+#include "tests/support/files.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/process.h"
+#include "harness/sweep/sweep_search.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "cli/cli.h"
-#include "settings.h"
-#include "support/files.h"
-#include "support/process.h"
+#include "harness/cli/cli.h"
+#include "engines/core/settings.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
 
 namespace tippe {
 namespace {

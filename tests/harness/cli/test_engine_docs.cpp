@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <string>
 
-#include "registry.h"
-#include "support/files.h"
-#include "support/process.h"
+#include "engines/core/registry.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
 
 namespace {
 

@@ -14,12 +14,12 @@
 #include <set>
 #include <sstream>
 
-#include "measure/compare.h"
-#include "gating/gate.h"
-#include "registry.h"
-#include "records/records.h"
-#include "io/scene_io.h"
-#include "support/files.h"
+#include "harness/measure/compare.h"
+#include "harness/gating/gate.h"
+#include "engines/core/registry.h"
+#include "harness/records/records.h"
+#include "harness/io/scene_io.h"
+#include "tests/support/files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

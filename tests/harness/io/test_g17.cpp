@@ -8,7 +8,7 @@
 #include <random>
 #include <string>
 
-#include "io/g17.h"
+#include "harness/io/g17.h"
 
 namespace tippe {
 namespace {

@@ -40,8 +40,8 @@
 #include <string>
 #include <vector>
 
-#include "support/files.h"
-#include "support/process.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
 
 namespace fs = std::filesystem;
 

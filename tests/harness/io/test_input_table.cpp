@@ -9,16 +9,16 @@
 #include <string>
 #include <vector>
 
-#include "measure/compare.h"
-#include "gating/gate.h"
-#include "records/records.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "io/toml_reader.h"
-#include "sweep/sweep.h"
-#include "support/files.h"
-#include "support/process.h"
-#include "support/fixtures.h"
+#include "harness/measure/compare.h"
+#include "harness/gating/gate.h"
+#include "harness/records/records.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/io/toml_reader.h"
+#include "harness/sweep/sweep.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
+#include "tests/support/fixtures.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

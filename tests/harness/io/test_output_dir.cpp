@@ -11,10 +11,10 @@
 #include <thread>
 #include <vector>
 
-#include "io/output_dir.h"
-#include "records/records.h"
-#include "support/files.h"
-#include "support/process.h"
+#include "harness/io/output_dir.h"
+#include "harness/records/records.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

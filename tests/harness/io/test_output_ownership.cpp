@@ -14,9 +14,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/output_dir.h"
-#include "support/files.h"
-#include "support/process.h"
+#include "harness/io/output_dir.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
 
 namespace fs = std::filesystem;
 

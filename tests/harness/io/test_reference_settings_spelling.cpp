@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "gating/gate.h"
-#include "registry.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "sweep/sweep.h"
+#include "harness/gating/gate.h"
+#include "engines/core/registry.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/sweep/sweep.h"
 
 namespace {
 

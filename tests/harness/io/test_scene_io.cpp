@@ -11,12 +11,12 @@
 #include <limits>
 #include <sstream>
 
-#include "records/records.h"
-#include "measure/run.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "support/files.h"
-#include "support/fixtures.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

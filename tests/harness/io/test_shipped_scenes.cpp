@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "../analytic/reference_model.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 namespace {

@@ -7,14 +7,14 @@
 #include <filesystem>
 #include <sstream>
 
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "library/columns.h"
-#include "library/verbs.h"
-#include "measure/run.h"
-#include "records/trajectory.h"
-#include "registry.h"
-#include "support/fixtures.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/library/columns.h"
+#include "harness/library/verbs.h"
+#include "harness/measure/run.h"
+#include "harness/records/trajectory.h"
+#include "engines/core/registry.h"
+#include "tests/support/fixtures.h"
 
 namespace tippe {
 namespace {

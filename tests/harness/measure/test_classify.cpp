@@ -5,12 +5,12 @@
 #include <string>
 #include <vector>
 
-#include "measure/classify.h"
-#include "measure/compare.h"
-#include "records/records.h"
-#include "measure/run.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
+#include "harness/measure/classify.h"
+#include "harness/measure/compare.h"
+#include "harness/records/records.h"
+#include "harness/measure/run.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 
 namespace tippe {
 namespace {

@@ -13,13 +13,13 @@
 #include <set>
 #include <sstream>
 
-#include "measure/compare.h"
-#include "report/gnuplot.h"
-#include "records/records.h"
-#include "report/report.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "support/files.h"
+#include "harness/measure/compare.h"
+#include "harness/report/gnuplot.h"
+#include "harness/records/records.h"
+#include "harness/report/report.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "tests/support/files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "measure/event_alignment.h"
-#include "records/comparison.h"
-#include "support/files.h"
+#include "harness/measure/event_alignment.h"
+#include "harness/records/comparison.h"
+#include "tests/support/files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

@@ -10,14 +10,14 @@
 #include <set>
 #include <sstream>
 
-#include "initial_state.h"
-#include "observables.h"
-#include "reference_model.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "sweep/sweep.h"
-#include "support/files.h"
-#include "report/sweep_analysis.h"
+#include "analytic/initial_state.h"
+#include "analytic/observables.h"
+#include "analytic/reference_model.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/sweep/sweep.h"
+#include "tests/support/files.h"
+#include "harness/report/sweep_analysis.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

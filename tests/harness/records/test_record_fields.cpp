@@ -8,12 +8,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "records/comparison.h"
-#include "records/fields.h"
-#include "records/metric_bounds.h"
-#include "records/record_schemas.h"
-#include "records/records.h"
-#include "support/files.h"
+#include "harness/records/comparison.h"
+#include "harness/records/fields.h"
+#include "harness/records/metric_bounds.h"
+#include "harness/records/record_schemas.h"
+#include "harness/records/records.h"
+#include "tests/support/files.h"
 
 namespace {
 

@@ -10,9 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "report/ledger_chart.h"
-#include "report/report.h"
-#include "support/files.h"
+#include "harness/report/ledger_chart.h"
+#include "harness/report/report.h"
+#include "tests/support/files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

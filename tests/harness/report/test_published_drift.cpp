@@ -9,8 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "support/files.h"
-#include "support/process.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
 
 namespace {
 

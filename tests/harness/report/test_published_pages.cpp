@@ -12,8 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "support/page_check.h"
-#include "support/files.h"
+#include "tests/support/page_check.h"
+#include "tests/support/files.h"
 
 namespace {
 

@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "measure/compare.h"
-#include "records/records.h"
-#include "report/document.h"
-#include "report/gnuplot.h"
-#include "report/report.h"
-#include "io/scene_io.h"
-#include "support/files.h"
+#include "harness/measure/compare.h"
+#include "harness/records/records.h"
+#include "harness/report/document.h"
+#include "harness/report/gnuplot.h"
+#include "harness/report/report.h"
+#include "harness/io/scene_io.h"
+#include "tests/support/files.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

@@ -5,11 +5,11 @@
 #include <string>
 #include <vector>
 
-#include "report/gnuplot.h"
-#include "report/report.h"
-#include "sweep/sweep.h"
-#include "support/files.h"
-#include "report/sweep_analysis.h"
+#include "harness/report/gnuplot.h"
+#include "harness/report/report.h"
+#include "harness/sweep/sweep.h"
+#include "tests/support/files.h"
+#include "harness/report/sweep_analysis.h"
 
 using namespace tippe;
 

@@ -8,9 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "report/gnuplot.h"
-#include "support/files.h"
-#include "support/process.h"
+#include "harness/report/gnuplot.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

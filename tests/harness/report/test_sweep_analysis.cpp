@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "report/sweep_analysis.h"
-#include "support/sweep_points.h"
+#include "harness/report/sweep_analysis.h"
+#include "tests/support/sweep_points.h"
 
 using namespace tippe;
 

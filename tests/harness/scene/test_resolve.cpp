@@ -7,12 +7,12 @@
 #include <variant>
 #include <vector>
 
-#include "io/scene_io.h"
-#include "registry.h"
-#include "scene/resolve.h"
-#include "support/files.h"
-#include "support/fixtures.h"
-#include "support/process.h"
+#include "harness/io/scene_io.h"
+#include "engines/core/registry.h"
+#include "harness/scene/resolve.h"
+#include "tests/support/files.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/process.h"
 
 namespace tippe {
 namespace {

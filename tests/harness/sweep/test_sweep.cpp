@@ -13,14 +13,14 @@
 #include <sstream>
 #include <thread>
 
-#include "io/scene_io.h"
-#include "sweep/sweep.h"
-#include "support/files.h"
-#include "support/process.h"
-#include "support/records.h"
-#include "report/sweep_analysis.h"
-#include "support/fixtures.h"
-#include "support/sweep_points.h"
+#include "harness/io/scene_io.h"
+#include "harness/sweep/sweep.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
+#include "tests/support/records.h"
+#include "harness/report/sweep_analysis.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/sweep_points.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

@@ -12,15 +12,15 @@
 #include <set>
 #include <thread>
 
-#include "sweep/mpi_farm.h"
-#include "sweep/sweep.h"
-#include "measure/task_farm.h"
-#include "support/files.h"
-#include "support/process.h"
-#include "support/records.h"
-#include "support/sweep_runs.h"
-#include "report/sweep_analysis.h"
-#include "support/fixtures.h"
+#include "harness/sweep/mpi_farm.h"
+#include "harness/sweep/sweep.h"
+#include "harness/measure/task_farm.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
+#include "tests/support/records.h"
+#include "tests/support/sweep_runs.h"
+#include "harness/report/sweep_analysis.h"
+#include "tests/support/fixtures.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

@@ -9,18 +9,18 @@
 #include <string>
 #include <vector>
 
-#include "gating/gate.h"
-#include "gating/gate_boundary.h"
-#include "simulator.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "sweep/sweep.h"
-#include "sweep/sweep_search.h"
-#include "support/files.h"
-#include "support/process.h"
-#include "support/records.h"
-#include "report/sweep_analysis.h"
-#include "support/fixtures.h"
+#include "harness/gating/gate.h"
+#include "harness/gating/gate_boundary.h"
+#include "engines/core/simulator.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/sweep/sweep.h"
+#include "harness/sweep/sweep_search.h"
+#include "tests/support/files.h"
+#include "tests/support/process.h"
+#include "tests/support/records.h"
+#include "harness/report/sweep_analysis.h"
+#include "tests/support/fixtures.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;

@@ -4,15 +4,15 @@
 #include <filesystem>
 #include <string>
 
-#include "io/files.h"
-#include "io/scene_io.h"
-#include "scene/resolve.h"
-#include "measure/compare.h"
-#include "report/sweep_analysis.h"
-#include "sweep/sweep.h"
-#include "support/fixtures.h"
-#include "support/records.h"
-#include "support/sweep_runs.h"
+#include "harness/io/files.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
+#include "harness/measure/compare.h"
+#include "harness/report/sweep_analysis.h"
+#include "harness/sweep/sweep.h"
+#include "tests/support/fixtures.h"
+#include "tests/support/records.h"
+#include "tests/support/sweep_runs.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
