@@ -42,7 +42,7 @@ class Filler {
   void operator()(const Field&, T& part) { visit(part, *this); }
   template <class T>
   void operator()(const Field&, std::optional<T>& part) {
-    part.emplace();
+    part = T{};  // not emplace(): clang finds a nested struct with member initializers not default-constructible here
     visit(*part, *this);
   }
   template <class T>
