@@ -380,8 +380,9 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
     } else if (n == 3) {
       // Three unknowns, mostly one sticking contact (rolling, Coulomb stick): the common case of
       // a rolling run. The closed-form inverse costs a fifth of the pivoting LU of the general
-      // case (BENCHMARKS.md). Singular relative to the entries' scale, not to Eigen's absolute
-      // 1e-12 on the determinant, which would misjudge a heavy body in SI units.
+      // case (docs/findings/reference-integration-cost.md). Singular relative to the entries'
+      // scale, not to Eigen's absolute 1e-12 on the determinant, which would misjudge a heavy
+      // body in SI units.
       const Eigen::Matrix3d K3 = K.topLeftCorner<3, 3>();
       const double scale = K3.cwiseAbs().maxCoeff();
       Eigen::Matrix3d inv = Eigen::Matrix3d::Zero();

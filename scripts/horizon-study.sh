@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The Coulomb scenes at the engines' default settings to their own horizon and to 30 s, MuJoCo in both body frames: a Markdown table on stdout (BENCHMARKS.md, "Verdicts, their horizon and the bench's choices"): scripts/horizon-study.sh [BUILD_DIR]
+# The Coulomb scenes at the engines' default settings to their own horizon and to 30 s, MuJoCo in both body frames: a Markdown table on stdout (docs/findings/verdict-horizon.md): scripts/horizon-study.sh [BUILD_DIR]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${1:-build}"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs Leine and Glocker's tippe top in an implementation nobody here wrote, for BENCHMARKS.md.
+"""Runs Leine and Glocker's tippe top in an implementation nobody here wrote, for docs/findings/leine-glocker-coupled.md.
 
 The model is the tippe-top benchmark of the public repository JonasBreuling/PyNonsmooth (checked
 at commit 93c16cd): "Tippetop_Leine2003", Leine and Glocker 2003, Chapter 5, as coded for

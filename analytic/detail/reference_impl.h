@@ -37,7 +37,7 @@ inline constexpr double kHoldApex = 1e-6;
 // below its Gauss-5 booking error on Bulirsch-Stoer (~7e-10 E0). Measured on every shipped scene against the per-sample quadrature
 // it replaces: the samples' ledgers move by at most 8e-11 E0 (rutstam_gliding_ball; 99 % of
 // every scene's samples by less than 1e-12 E0), the run's final ledger by round-off
-// (BENCHMARKS.md, "A sample's energy ledger without a contact solve").
+// (docs/findings/reference-sample-cost.md).
 inline constexpr double kFitTolerance = 1e-13;
 
 inline const char* slot_name(int s) { return s == 0 ? "ball" : "stem"; }

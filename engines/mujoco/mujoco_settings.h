@@ -50,7 +50,7 @@ struct MujocoSettings {
   // Friction coefficient that stands in for the rolling constraint (friction = rolling).
   double rolling_mu = 1e3;
   // Where the free body's frame (and so its joint) has its origin: a modelling choice, not
-  // physics, yet MuJoCo 2.2.2's answer depends on it (BENCHMARKS.md, "MuJoCo's body frame").
+  // physics, yet MuJoCo 2.2.2's answer depends on it (docs/findings/mujoco-body-frame.md).
   // MuJoCo applies its soft-constraint law to J qacc and never computes J-dot qvel
   // (mj_fwdConstraint: efc_b = J qacc_smooth - aref); for a free joint that omitted term depends
   // on the frame origin. "ball_centre" (the default): the origin at the ball's centre O, where the

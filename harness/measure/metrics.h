@@ -42,7 +42,7 @@ namespace tippe {
 //     a gain; with it (the tolerance is 5.1e-6 E0 there) it is not, while MuJoCo's Euler integrator's real gains on
 //     that top (1.5e-4 E0 at 1e-4) still are. The allowance was set after seeing those runs, at
 //     the bench's stated geometric resolution, not at the runs' numbers.
-// BENCHMARKS.md ("One criterion of safe") gives what the change of rule moved.
+// docs/findings/energy-gain-rule.md gives what the change of rule moved.
 inline constexpr double kEnergyGainTolerance = 1e-6;
 
 // The rule applied to one trajectory (E0 = its first energy; |E0| = 0 makes the tolerance
@@ -71,7 +71,7 @@ struct EnergyGains {
 //  - Total (the default): the rule is applied to E itself, every rise a gain.
 // Why Total is the default: the ledger books each engine's contact work per step from the forces
 // it reports, and that booking has errors of its own well above the 1e-6 E0 tolerance (measured,
-// BENCHMARKS.md "The energy ledger per run": rises of the ledger's created energy of 5e-5 .. 4e-3
+// docs/findings/energy-gain-rule.md: rises of the ledger's created energy of 5e-5 .. 4e-3
 // E0 at the stem's touchdown on toy_viscous and 3e-5 .. 7e-3 E0 through the Coulomb tops'
 // stick-slip on leine_glocker, 70-172 of them per engine, where the total rule counts 0-26), so a
 // class counted on it would rest on the bench's bookkeeping, not the engine. The ledger rule is

@@ -58,7 +58,7 @@ TEST(LeineGlockerPublished, StemTouchdownAgreesWithAnIndependentImplementation) 
 // 1.489 s (the independent implementation, step 1e-5: 3.127 rad at 1.4927 s). The figure's
 // ~1.5 s is that moment, read to two digits (+-0.05 s); the first contact
 // is 0.127 s earlier, which is why reading the figure's time as the touchdown looked like a
-// disagreement (withdrawn, BENCHMARKS.md).
+// disagreement (withdrawn, docs/findings/leine-glocker-coupled.md).
 TEST(LeineGlockerPublished, StandsOnItsStemAtThePublishedTime) {
   const Scene s = fixtures::shipped_reference_scene("leine_glocker_coupled");
   ReferenceModel m(s);

@@ -120,9 +120,9 @@ namespace {
 // converged one (bulirsch_stoer, rtol 1e-12); divided by the approach speed it predicts the
 // touchdown's shift. Measured (runs of 20 time units): predicted +2.89e-7, -1.58e-7, +1.39e-7
 // against +2.82e-7, -1.53e-7, +1.36e-7 (bulirsch_stoer, dopri5, rosenbrock4); the impacts after
-// it multiply the shift by ~3 each (BENCHMARKS.md). 20 % allows for the gap's curvature over the
-// last 0.01 (the speed changes by ~10 % there); the shift must be well above the location's
-// own error (1e-8: the converged runs agree to 4e-11).
+// it multiply the shift by ~3 each (docs/findings/reference-after-touchdown.md). 20 % allows for
+// the gap's curvature over the last 0.01 (the speed changes by ~10 % there); the shift must be
+// well above the location's own error (1e-8: the converged runs agree to 4e-11).
 struct Probe {
   double t_touch = -1, gap = 0, gap_rate = 0;
 };

@@ -212,7 +212,7 @@ TEST(GlidingEngines, MujocoInvertsLikeTheReference) { expect_engine_inverts_like
 // stand-in (rutstam_ball: -20 %), not an error of the explicit law (the sliding ball below is
 // right to 5e-5). In kg and m this ball's inertia determinant (A^2 C = 2.9e-17 kg^3 m^6) is below
 // the DBL_EPSILON guard of Bullet's implicit gyroscopic solve, so Bullet drops w x I w
-// (BENCHMARKS.md, "Bullet and the length scale"). In grams it does not: the test below.
+// (docs/findings/bullet-length-scale.md). In grams it does not: the test below.
 TEST(GlidingEngines, DISABLED_BulletInvertsLikeTheReference) { expect_engine_inverts_like_the_reference("bullet"); }
 
 // The same in grams (engines.bullet.mass_unit = 1e-3): Bullet keeps its gyroscopic term and

@@ -392,7 +392,7 @@ TEST(Mujoco, FrameDoesNotChangeFreeFlight) {
   EXPECT_LE((x.w_B - y.w_B).norm(), 1e-9);
 }
 
-// On the floor it does (BENCHMARKS.md, "MuJoCo's body frame"): the setting must reach the model.
+// On the floor it does (docs/findings/mujoco-body-frame.md): the setting must reach the model.
 // After 0.5 time units of the sliding dimensionless top the two frames part by far more than the
 // free-flight agreement above.
 TEST(Mujoco, FrameChangesTheContactRun) {
