@@ -27,7 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string g3(double v) {
+std::string sig3(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.3g", v);
   return buf;
@@ -216,7 +216,7 @@ void choose_advice(AdviceEngine& e, const SearchCriterion& criterion, const std:
         if (b.status == "incomplete") why = " (a search did not finish)";
       e.reason = "no configuration is safe at any " + e.knob + " in the searched range, even the finest" + why;
     } else {
-      e.reason = "the search found a safe " + e.knob + " but the confirming run at the boundary / " + g3(kAdviceMargin) +
+      e.reason = "the search found a safe " + e.knob + " but the confirming run at the boundary / " + sig3(kAdviceMargin) +
                  " was not safe: the criterion is not monotonic in the " + e.knob;
     }
   }
@@ -248,11 +248,11 @@ void choose_advice(AdviceEngine& e, const SearchCriterion& criterion, const std:
     else if (lo == 0) sentence = key + " decides whether any " + e.knob + " is safe";
     else if (hi / lo < std::pow(10.0, e.boundaries.front().search.resolution) + 1e-12)
       sentence = key + " moved the boundary not at all (within the search's resolution)";
-    else sentence = key + " moved the boundary " + g3(hi / lo) + "x";
+    else sentence = key + " moved the boundary " + sig3(hi / lo) + "x";
     e.sensitivity.push_back(sentence);
     for (const std::string& v : order)
-      e.sensitivity_rows.push_back({key, unquote(v), best_of[v] > 0 ? g3(best_of[v]) : "none safe",
-                                    best_of[v] > 0 && hi > 0 ? g3(hi / best_of[v]) : "-"});
+      e.sensitivity_rows.push_back({key, unquote(v), best_of[v] > 0 ? sig3(best_of[v]) : "none safe",
+                                    best_of[v] > 0 && hi > 0 ? sig3(hi / best_of[v]) : "-"});
   }
 }
 
@@ -266,7 +266,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
   const Scene scene = load_scene(o.scene, over);  // its own errors name the file and key
   res.scene_name = scene.name;
   res.duration = scene.run.duration;
-  res.criterion = o.criterion.empty() ? "regime and inversion within " + g3(100 * o.tolerance) + "%" : o.criterion;
+  res.criterion = o.criterion.empty() ? "regime and inversion within " + sig3(100 * o.tolerance) + "%" : o.criterion;
   const SearchCriterion criterion = parse_criterion(res.criterion);
   res.criterion = criterion_text(criterion);
 
@@ -321,7 +321,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
   std::vector<SweepRecord> confirm;
   if (!confirm_setups.empty()) {
     write_file_atomic((out / "confirm-sweep.toml").string(),
-                      sweep_text("confirming runs of " + what + " at the boundary / " + g3(kAdviceMargin), scene_rel,
+                      sweep_text("confirming runs of " + what + " at the boundary / " + sig3(kAdviceMargin), scene_rel,
                                  o.duration, confirm_setups));
     confirm = run_sweep_file((out / "confirm-sweep.toml").string(), (out / "confirm").string(), o, res.runs, false);
   }
@@ -337,7 +337,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
     std::vector<std::string> set = c.set();
     set.push_back(knob_key(e.engine, e.knob) + "=" + search_value_text(e.step));
     gate += "\n# " + e.engine + ": " + c.text() + ", " + e.knob + " " + search_value_text(e.step) + " (the boundary " +
-            search_value_text(e.boundary) + " / " + g3(kAdviceMargin) + "; " + g3(e.cpu_seconds) + " CPU s).\n";
+            search_value_text(e.boundary) + " / " + sig3(kAdviceMargin) + "; " + sig3(e.cpu_seconds) + " CPU s).\n";
     gate += "[[check]]\nname = " + toml_string(e.engine + "-advised") + "\nscene = " + toml_string(scene_rel) +
             "\nengine = " + toml_string(e.engine) + "\nduration = " + search_value_text(res.duration) + "\nset = [";
     for (size_t i = 0; i < set.size(); ++i) gate += (i ? ", " : "") + toml_string(set[i]);
@@ -382,7 +382,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
       const AdviceConfig& c = e.configs[*e.chosen];
       t += c.text() + ", " + e.knob + " " + search_value_text(e.step) + " keeps the top " +
            (res.reference_inverts ? "inverting like the reference" : "in the reference's regime (no inversion)") +
-           " to t = " + g3(res.duration) + " (" + res.criterion + "); " + g3(e.cpu_seconds) +
+           " to t = " + sig3(res.duration) + " (" + res.criterion + "); " + sig3(e.cpu_seconds) +
            " CPU s; the largest safe " + e.knob + " is " + search_value_text(e.boundary) +
            (e.beyond > 0 ? " (unsafe at " + search_value_text(e.beyond) + ")" : " (safe to the end of the range)");
       if (!e.sensitivity.empty()) t += "; " + join(e.sensitivity, ", ");
@@ -395,7 +395,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
   }
   doc.para(std::string("Safe: the run finished, the stability map classes it ok (no divergence, no net energy gain "
                        "above 1e-6 E0 and the energy of 1e-4 R of contact depth in a dissipative scene, no Jellett drift where J is conserved), and ") +
-           res.criterion + ". The advised " + "step is the largest safe step found / " + g3(kAdviceMargin) +
+           res.criterion + ". The advised " + "step is the largest safe step found / " + sig3(kAdviceMargin) +
            ", confirmed by a run there. " +
            (res.gate_written ? "advice.toml is the gate that keeps it: `tippe gate advice.toml`."
                              : "No engine has advice: no gate is written."));
@@ -409,7 +409,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
       t.rows.push_back({e.engine, e.configs[i].text(), b.status.empty() ? "no records" : b.status,
                         b.boundary ? search_value_text(*b.boundary) : "-", b.beyond ? search_value_text(*b.beyond) : "-",
                         std::to_string(b.runs), chosen ? search_value_text(e.step) + " (confirmed)" : "",
-                        chosen ? g3(e.cpu_seconds) : ""});
+                        chosen ? sig3(e.cpu_seconds) : ""});
     }
     for (const AdviceConfig& c : e.unsearched) t.rows.push_back({e.engine, c.text(), "not searched (budget)", "", "", "0", "", ""});
   }

@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include "harness/io/scene_io.h"
+#include "harness/io/text.h"
 #include "harness/sweep/sweep_search.h"
 #include "harness/io/toml_reader.h"
 
@@ -19,11 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string g6(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 }  // namespace
 

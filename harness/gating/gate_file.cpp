@@ -51,13 +51,6 @@ const std::vector<std::string>& run_statuses() {
   return s;
 }
 
-// The scene's own message without its "FILE: " prefix, with the scene file named at the end.
-std::string quote_scene_error(const SceneError& e, const std::string& scene_path) {
-  std::string msg = e.what();
-  const std::string prefix = scene_path + ": ";
-  if (msg.rfind(prefix, 0) == 0) msg = msg.substr(prefix.size()) + " (scene " + scene_path + ")";
-  return msg;
-}
 
 // The key a scene error is about ("engines.ode.timestep"), or "" when it names none.
 std::string scene_error_key(const SceneError& e, const std::string& scene_path) {

@@ -13,13 +13,9 @@
 
 namespace tippe {
 
-namespace {
-
 std::string errno_text() { return std::strerror(errno); }
 
 std::string temp_name(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
-
-}  // namespace
 
 void write_file_atomic(const std::string& path, const std::string& text) {
   const std::string tmp = temp_name(path);

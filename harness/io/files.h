@@ -24,6 +24,11 @@ constexpr size_t kMaxRecordFileBytes = size_t{1} << 30;
 // sample count by it, so that no trajectory outgrows kMaxRecordFileBytes.
 constexpr size_t kTrajectoryRowMax = 33 * 32;
 
+// What errno says now (strerror), for an error message.
+std::string errno_text();
+// The temporary a file is written to before it is renamed into place: `path.tmp.PID`.
+std::string temp_name(const std::string& path);
+
 // Writes `text` to `path.tmp.PID`, fsyncs it and renames it over `path`, so readers see the old
 // file or the new one, never a part. Throws OutputError (temporary removed) on failure.
 void write_file_atomic(const std::string& path, const std::string& text);

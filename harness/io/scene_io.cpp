@@ -436,4 +436,11 @@ std::set<std::string> overridden_keys(const std::vector<std::string>& overrides)
   return keys;
 }
 
+std::string quote_scene_error(const SceneError& e, const std::string& scene_path) {
+  std::string msg = e.what();
+  const std::string prefix = scene_path + ": ";
+  if (msg.rfind(prefix, 0) == 0) msg = msg.substr(prefix.size()) + " (scene " + scene_path + ")";
+  return msg;
+}
+
 }  // namespace tippe

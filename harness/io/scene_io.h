@@ -26,6 +26,10 @@ class SceneError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A scene error quoted by another file's reader (a sweep or gate naming the scene): the scene's own
+// message without its "FILE: " prefix, with the scene file named at the end.
+std::string quote_scene_error(const SceneError& e, const std::string& scene_path);
+
 // A scene as its file says it: every key checked but the [engines.NAME] tables, which are only
 // copied (bool, integer -> long long, float -> double, string, array of numbers -> vector<double>).
 // What the tables mean (each engine's settings, the reference's, an engine's files) is the

@@ -26,6 +26,14 @@ inline std::string num(double v) {
   return os.str();
 }
 
+// A number in a generated message or table at 6 significant digits, as printf's "%.6g" (the
+// one such helper: gates, sweep criteria, the classifier, the self-check and the MJCF importer).
+inline std::string g6(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
 // A measured value in a CI log or a table: short, yet long enough that a value just over a
 // threshold does not print equal to it (6 digits); integral values (steps, counts) print without
 // an exponent; nan, inf and -inf as words.

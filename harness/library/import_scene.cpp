@@ -8,6 +8,7 @@
 
 #include "harness/io/output_dir.h"
 #include "harness/io/scene_io.h"
+#include "harness/io/text.h"
 #include "harness/scene/resolve.h"
 #include "harness/library/verbs.h"
 #include "engines/mujoco/mujoco_api.h"
@@ -27,13 +28,6 @@ std::string tf(double v) {
   return s;
 }
 
-std::string short_number(double v) {
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
-  os.precision(6);
-  os << v;
-  return os.str();
-}
 
 // A TOML basic string: the text is UTF-8 (checked), quotes, backslashes and controls escaped.
 std::string ts(const std::string& text) {
@@ -90,8 +84,8 @@ std::string scene_text(const MjcfTopImport& top, const MjcfSceneRequest& o, cons
   t << "com_offset = " << tf(top.mass.com_offset) << "\n";
   t << "inertia_transverse = " << tf(top.mass.inertia_transverse) << "\n";
   t << "inertia_axial = " << tf(top.mass.inertia_axial) << "\n\n[contact]\n";
-  t << "# condim " << top.condim << ", friction " << short_number(top.contact_friction[0]) << " "
-    << short_number(top.contact_friction[2]) << " " << short_number(top.contact_friction[3])
+  t << "# condim " << top.condim << ", friction " << g6(top.contact_friction[0]) << " "
+    << g6(top.contact_friction[2]) << " " << g6(top.contact_friction[3])
     << " (MuJoCo's mixing of the ball's and the floor's)\n";
   t << "friction = " << ts(to_string(top.contact.friction)) << "\n";
   if (top.contact.friction == FrictionLaw::Coulomb) t << "mu = " << tf(top.contact.mu) << "\n";

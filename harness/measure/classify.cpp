@@ -1,5 +1,6 @@
 // Classification of one finished run: ok, or what went wrong first (diverged, unphysical, clamped, failed, contact_lost) and when.
 #include "harness/measure/classify.h"
+#include "harness/io/text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,15 +14,7 @@ namespace tippe {
 
 namespace {
 
-// The same guard as SampleSummary's, so a drift here is the number the reports show.
-constexpr double kTinyJ = 1e-300;
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
 
 struct Finding {
   double time;
@@ -50,7 +43,7 @@ std::optional<Finding> first_divergence(const Trajectory& tr) {
         !std::isfinite(tr.jellett[k]))
       return Finding{t, "non-finite sample (t, tilt, energy or Jellett's J)"};
     if (e0 > 0 && tr.energy[k] > factor * e0)
-      return Finding{t, "energy " + num(tr.energy[k]) + " above " + num(factor) + " E0 = " + num(factor * e0)};
+      return Finding{t, "energy " + g6(tr.energy[k]) + " above " + g6(factor) + " E0 = " + g6(factor * e0)};
   }
   return std::nullopt;
 }
@@ -65,9 +58,9 @@ std::optional<Finding> first_energy_gain(const Scene& scene, const Trajectory& t
                       std::isfinite(tr.numerical_energy.back());
   return Finding{g.time, std::string(ledger ? "energy created (by the ledger: not friction work, not released from the contact's store) rose by "
                                             : "energy rose by ") +
-                             num(g.rise_at_first) + (relative ? " E0" : "") + " between t = " + num(g.since) +
-                             " (its lowest so far) and " + num(g.time) + " in a dissipative scene (tolerance " +
-                             num(g.tolerance) + " E0 on the net rise: 1e-06 E0 and the energy of 1e-4 R of contact depth; energy_gain_rule = " +
+                             g6(g.rise_at_first) + (relative ? " E0" : "") + " between t = " + g6(g.since) +
+                             " (its lowest so far) and " + g6(g.time) + " in a dissipative scene (tolerance " +
+                             g6(g.tolerance) + " E0 on the net rise: 1e-06 E0 and the energy of 1e-4 R of contact depth; energy_gain_rule = " +
                              to_string(rule) + ")"};
 }
 
@@ -88,9 +81,9 @@ std::optional<Finding> first_jellett_drift(const Trajectory& tr, const RunRecord
     if (!drift || !(*drift > kJellettDriftTolerance)) continue;
     any = true;
     if (!undated)
-      undated = Finding{std::nan(""), "Jellett's J drifted by " + num(*drift) + " relative on the " +
+      undated = Finding{std::nan(""), "Jellett's J drifted by " + g6(*drift) + " relative on the " +
                                           to_string(static_cast<Surface>(s)) + " (tolerance " +
-                                          num(kJellettDriftTolerance) + "; no sample dates it)"};
+                                          g6(kJellettDriftTolerance) + "; no sample dates it)"};
   }
   if (!any) return std::nullopt;
 
@@ -122,12 +115,12 @@ std::optional<Finding> first_jellett_drift(const Trajectory& tr, const RunRecord
     }
     const auto flagged = record_drift(run, s);
     if (!flagged || !(*flagged > kJellettDriftTolerance)) continue;
-    const double drift = std::abs(tr.jellett[k] - j0) / std::max(std::abs(j0), kTinyJ);
+    const double drift = jellett_relative_drift(tr.jellett[k], j0);
     if (drift > kJellettDriftTolerance)
-      return Finding{tr.t[k], "Jellett's J drifted by " + num(drift) + " relative on the " +
-                                  to_string(static_cast<Surface>(s)) + " since t = " + num(run_start) +
-                                  " (tolerance " + num(kJellettDriftTolerance) + "; J is conserved there; " +
-                                  num(*flagged) + " over the run)"};
+      return Finding{tr.t[k], "Jellett's J drifted by " + g6(drift) + " relative on the " +
+                                  to_string(static_cast<Surface>(s)) + " since t = " + g6(run_start) +
+                                  " (tolerance " + g6(kJellettDriftTolerance) + "; J is conserved there; " +
+                                  g6(*flagged) + " over the run)"};
   }
   return undated;
 }
@@ -169,7 +162,7 @@ RunClass classify_run(const Scene& scene, const RunRecord& run, const Metrics* v
     if (out.reason.empty()) out.reason = run.status;
     // What the engine's verdict hides but a reader wants: an earlier sign of trouble.
     if (const auto early = first_unphysical(scene, run, trajectory); early && early->time < run.status_time)
-      out.reason += "; earlier, at t = " + num(early->time) + ": " + early->reason;
+      out.reason += "; earlier, at t = " + g6(early->time) + ": " + early->reason;
     return out;
   }
 
@@ -180,8 +173,8 @@ RunClass classify_run(const Scene& scene, const RunRecord& run, const Metrics* v
     const double nan = std::nan("");
     if (vs_reference && energy_must_not_rise(scene) && vs_reference->energy_gain_events > 0)
       return {RunClassKind::Unphysical, nan,
-              std::to_string(vs_reference->energy_gain_events) + " net energy rises above the tolerance (" + num(kEnergyGainTolerance) +
-                  " E0 and the energy of 1e-4 R of contact depth) in a dissipative scene (largest " + num(vs_reference->energy_max_gain) +
+              std::to_string(vs_reference->energy_gain_events) + " net energy rises above the tolerance (" + g6(kEnergyGainTolerance) +
+                  " E0 and the energy of 1e-4 R of contact depth) in a dissipative scene (largest " + g6(vs_reference->energy_max_gain) +
                   " E0; no trajectory to date them)"};
   }
   return out;

@@ -36,7 +36,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Passes samples on to `inner`; remembers the first failure instead of losing it in the
 // simulator's stack. `fatal` rethrows (the run is pointless without this output); otherwise the

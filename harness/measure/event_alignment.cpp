@@ -35,7 +35,7 @@ bool is_failure_status(const std::string& name) {
   return statuses.count(name) > 0;
 }
 
-std::string time_text(double t) {
+std::string event_time_text(double t) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", t);
   return buf;
@@ -114,7 +114,7 @@ const char* to_string(AlignOp op) {
 
 std::string event_text(const std::vector<CanonicalEvent>& side, const std::optional<size_t>& i) {
   if (!i) return "none";
-  return side[*i].kind + " at t=" + time_text(side[*i].time);
+  return side[*i].kind + " at t=" + event_time_text(side[*i].time);
 }
 
 EventAlignment align_events(const std::vector<CanonicalEvent>& reference, const std::vector<CanonicalEvent>& engine) {

@@ -16,7 +16,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Accumulates |difference| over the common grid.
 struct ErrorStats {
   double sum_sq = 0, max = 0;

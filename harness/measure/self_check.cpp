@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include "harness/io/json_fields.h"
+#include "harness/io/text.h"
 #include "harness/records/records.h"
 #include "harness/measure/run.h"
 #include "engines/core/registry.h"
@@ -30,11 +31,6 @@ double self_check_event_tolerance(const Scene& scene) {
 
 namespace {
 
-std::string short_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 // The earliest of several places where the two runs part.
 struct Parting {
@@ -58,7 +54,7 @@ SelfCheck compare_reference_runs(const RunRecord& reference, const Trajectory& r
   sc.rtol = plan.rtol;
   sc.atol = plan.atol;
   sc.cpu_seconds = check.work.cpu_seconds;
-  const std::string a = scene.run.method, b = plan.method == a ? a + " at rtol " + short_number(plan.rtol) : plan.method;
+  const std::string a = scene.run.method, b = plan.method == a ? a + " at rtol " + g6(plan.rtol) : plan.method;
   Parting part;
 
   // Events, in order: the same names and details, at times within the tolerance.
@@ -71,16 +67,16 @@ SelfCheck compare_reference_runs(const RunRecord& reference, const Trajectory& r
     const Event& y = eb[i];
     if (x.name != y.name || x.detail != y.detail) {
       part.consider(std::min(x.time, y.time), "event " + std::to_string(i) + ": " + a + " has " + x.name + " (" +
-                                                 x.detail + ") at t = " + short_number(x.time) + ", " + b +
+                                                 x.detail + ") at t = " + g6(x.time) + ", " + b +
                                                  " has " + y.name + " (" + y.detail + ") at t = " +
-                                                 short_number(y.time));
+                                                 g6(y.time));
       break;
     }
     if (!(std::abs(x.time - y.time) <= tol)) {
       part.consider(std::min(x.time, y.time), "event " + std::to_string(i) + " (" + x.name + ") at t = " +
-                                                 short_number(x.time) + " and " + short_number(y.time) +
-                                                 ": the times differ by " + short_number(std::abs(x.time - y.time)) +
-                                                 " > " + short_number(tol));
+                                                 g6(x.time) + " and " + g6(y.time) +
+                                                 ": the times differ by " + g6(std::abs(x.time - y.time)) +
+                                                 " > " + g6(tol));
       break;
     }
   }
@@ -88,13 +84,13 @@ SelfCheck compare_reference_runs(const RunRecord& reference, const Trajectory& r
     const bool ref_longer = ea.size() > eb.size();
     const Event& extra = ref_longer ? ea[n] : eb[n];
     part.consider(extra.time, (ref_longer ? a : b) + " has " + std::to_string((ref_longer ? ea : eb).size() - n) +
-                                  " more event(s) from " + extra.name + " at t = " + short_number(extra.time));
+                                  " more event(s) from " + extra.name + " at t = " + g6(extra.time));
   }
   // The reference's own warning: past it, event times are not fixed by the motion.
   for (const auto* events : {&ea, &eb})
     for (const Event& e : *events)
       if (e.name == "unresolved") {
-        part.consider(e.time, "unresolved at t = " + short_number(e.time) + ": " + e.detail);
+        part.consider(e.time, "unresolved at t = " + g6(e.time) + ": " + e.detail);
         break;
       }
 
@@ -103,7 +99,7 @@ SelfCheck compare_reference_runs(const RunRecord& reference, const Trajectory& r
     part.consider(std::min(reference.status == "ok" ? check.status_time : reference.status_time,
                            check.status == "ok" ? reference.status_time : check.status_time),
                   a + " ends " + reference.status + ", " + b + " " + check.status +
-                      (check.status != "ok" ? " at t = " + short_number(check.status_time) + " (" +
+                      (check.status != "ok" ? " at t = " + g6(check.status_time) + " (" +
                                                   check.status_detail + ")"
                                             : std::string()));
 
@@ -120,8 +116,8 @@ SelfCheck compare_reference_runs(const RunRecord& reference, const Trajectory& r
     const double until = k ? ref_traj.t[k - 1] : 0.0;
     const bool tilt = !(dth <= kSelfCheckStateTolerance);
     part.consider(until, std::string(tilt ? "the tilt" : "the energy") + " differs by " +
-                             short_number(tilt ? dth : de) + (tilt ? " rad" : " E0") + " > " +
-                             short_number(kSelfCheckStateTolerance) + " at t = " + short_number(ref_traj.t[k]));
+                             g6(tilt ? dth : de) + (tilt ? " rad" : " E0") + " > " +
+                             g6(kSelfCheckStateTolerance) + " at t = " + g6(ref_traj.t[k]));
     break;
   }
   sc.converged_until = part.t;

@@ -21,6 +21,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "harness/io/files.h"
 #include "harness/io/g17.h"
 #include "harness/io/provenance.h"
 
@@ -30,15 +31,9 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// Floor of the relative-drift denominator: J = 0 exactly (no spin) must not divide by zero.
-constexpr double kTinyJ = 1e-300;
 
 
 
-std::string errno_text() { return std::strerror(errno); }
-
-std::string temp_name(const std::string& path) { return path + ".tmp." + std::to_string(::getpid()); }
 
 }  // namespace
 
@@ -90,7 +85,7 @@ void SampleSummary::add(const Observation& o, bool contact_switched) {
     run_surface_ = o.surface;
     run_j0_ = o.jellett;
   } else {
-    drift = std::abs(o.jellett - run_j0_) / std::max(std::abs(run_j0_), kTinyJ);
+    drift = jellett_relative_drift(o.jellett, run_j0_);
   }
   auto& slot = o.surface == Surface::Ball ? drift_ball_ : drift_stem_;
   slot = std::max(slot.value_or(0.0), drift);

@@ -1,6 +1,8 @@
 // Run records: their summary numbers, JSON and CSV writers, atomic files.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdio>
 #include <istream>
@@ -231,6 +233,18 @@ struct SampleSink {
   virtual ~SampleSink() = default;
   virtual void write(const Observation& o) = 0;
 };
+
+// A number without a value (a metric with nothing to measure, a ledger term an engine does not
+// report).
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Jellett's J's drift relative to its value j0 where the contact surface last changed; the floor
+// keeps J = 0 exactly (no spin) from dividing by zero. The summary and the classifier both use it,
+// so a drift the classifier names is the number the reports show.
+inline double jellett_relative_drift(double j, double j0) {
+  constexpr double kTinyJ = 1e-300;
+  return std::abs(j - j0) / std::max(std::abs(j0), kTinyJ);
+}
 
 // Folds samples into the summary numbers of a RunRecord (used by run_simulator; public so that
 // the numbers can be recomputed or tested on any sequence).

@@ -38,11 +38,6 @@ std::string grid_text(const SweepRecord& r) { return axis_text(r.grid_value, r.g
 
 namespace {
 
-std::string g6(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 // "1%" -> 0.01, "0.01" -> 0.01; throws for anything else or a value outside (0, 10].
 double parse_inversion_tolerance(const std::string& text) {

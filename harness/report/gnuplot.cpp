@@ -87,7 +87,7 @@ int run_gnuplot(const std::string& program, const std::filesystem::path& dir, co
 
 namespace {
 
-std::string num(double v) {
+std::string g9(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.9g", v);
   return buf;
@@ -110,17 +110,17 @@ std::string gnuplot_script(const GpPage& page, const std::vector<GpFigure>& figu
     s += f.logx ? "set logscale x\nset format x '%g'\n" : "unset logscale x\nset format x '%g'\n";
     s += f.logy ? "set logscale y\nset format y '%g'\n" : "unset logscale y\nset format y '%g'\n";
     s += f.equal_axes ? "set size ratio -1\n" : "set size noratio\n";
-    s += f.yrange ? "set yrange [" + num(f.yrange->first) + ":" + num(f.yrange->second) + "]\n"
+    s += f.yrange ? "set yrange [" + g9(f.yrange->first) + ":" + g9(f.yrange->second) + "]\n"
                   : std::string("set autoscale y\n");
     // Keeps the extreme points of a log axis off the frame.
     s += std::string("set offsets ") + (f.logx ? "graph 0.04, graph 0.04" : "0, 0") + ", " +
          (f.logx || f.logy ? "graph 0.06, graph 0.06" : "0, 0") + "\n";
     s += "unset arrow\n";
     if (f.xmark && std::isfinite(*f.xmark))
-      s += "set arrow 1 from " + num(*f.xmark) + ", graph 0 to " + num(*f.xmark) +
+      s += "set arrow 1 from " + g9(*f.xmark) + ", graph 0 to " + g9(*f.xmark) +
            ", graph 1 nohead dashtype 2 lc rgb '#888888'\n";
     if (f.ymark && std::isfinite(*f.ymark))
-      s += "set arrow 2 from graph 0, first " + num(*f.ymark) + " to graph 1, first " + num(*f.ymark) +
+      s += "set arrow 2 from graph 0, first " + g9(*f.ymark) + " to graph 1, first " + g9(*f.ymark) +
            " nohead dashtype 2 lc rgb '#555555'\n";
     s += "plot ";
     for (size_t i = 0; i < f.series.size(); ++i) {
@@ -130,10 +130,10 @@ std::string gnuplot_script(const GpPage& page, const std::vector<GpFigure>& figu
       if (r.points_only)
         s += " with points pt " + std::to_string(r.point_type) + " ps 1.2";
       else if (r.point_type > 0)
-        s += " with linespoints lw " + num(r.line_width) + " dt " + std::to_string(r.dash) + " pt " +
+        s += " with linespoints lw " + g9(r.line_width) + " dt " + std::to_string(r.dash) + " pt " +
              std::to_string(r.point_type) + " pi " + std::to_string(r.point_every < 1 ? 1 : r.point_every) + " ps 0.9";
       else
-        s += " with lines lw " + num(r.line_width) + " dt " + std::to_string(r.dash);
+        s += " with lines lw " + g9(r.line_width) + " dt " + std::to_string(r.dash);
       s += " lc rgb " + gp_literal(r.colour) + " title columnheader(1)";
     }
     s += "\nunset output\n";

@@ -46,12 +46,12 @@ std::string trend_text(const RegimeTrend& tr) {
 }
 
 // A table of text cells, with an optional CSS class per cell (same shape as rows; "" for none).
-struct Table {
+struct SweepTable {
   std::vector<std::string> header;
   std::vector<std::vector<std::string>> rows;
   std::vector<std::vector<std::string>> css = {};
 };
-DocTable to_doc(const Table& t) {
+DocTable to_doc(const SweepTable& t) {
   DocTable d;
   d.header = t.header;
   for (size_t i = 0; i < t.rows.size(); ++i) {
@@ -119,7 +119,7 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
              "stability map, |relative inversion-time error| <= the bound). \"Analytic at least as "
              "accurate\": the cheapest point of the analytic model's own ladders with an error no larger than "
              "this point's; the ratio is this point's CPU time over that one's.");
-    Table t{{"engine", "error below", "setup", "setting", "inversion error", "CPU s", "steps",
+    SweepTable t{{"engine", "error below", "setup", "setting", "inversion error", "CPU s", "steps",
              "analytic at least as accurate", "cost ratio"},
             {}};
     for (const std::string& e : engines) {
@@ -150,7 +150,7 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
   }
 
   // Convergence in the time step: only ladders over a time step have one.
-  Table conv{{"setup", "engine", "ladder", "order (inversion time)", "points in the asymptotic range",
+  SweepTable conv{{"setup", "engine", "ladder", "order (inversion time)", "points in the asymptotic range",
               "order (tilt RMS)", "points in the asymptotic range"},
              {}};
   for (const SetupGroup& u : s.setups)
@@ -200,7 +200,7 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
                             "goes away as the step shrinks (the finest runs roll), only moves later (every finished "
                             "run inverts, later at a smaller step), or converges (the two finest runs invert within "
                             "1 % of each other: the engine's model, not its step)."));
-  Table reg{{"setup", "engine", "softest safe setting in the reference's regime", "points not safe",
+  SweepTable reg{{"setup", "engine", "softest safe setting in the reference's regime", "points not safe",
              "as the step shrinks"},
             {}};
   for (const SetupGroup& u : s.setups)
@@ -233,7 +233,7 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
   }
 
   doc.heading(3, "Every point");
-  Table all_t{{"setup", "setting", "status", "class", "inversion t", "inversion error", "stem contact error", "tilt RMS (rad)",
+  SweepTable all_t{{"setup", "setting", "status", "class", "inversion t", "inversion error", "stem contact error", "tilt RMS (rad)",
                "energy max (/E0)", "contact path RMS (/R)", "CPU s (min)", "steps", "rhs evals", "solver iters"},
               {}};
   for (const SetupGroup& u : s.setups)
@@ -282,7 +282,7 @@ void stability_section(const std::vector<SceneGroup>& scenes, Document& doc) {
         }
     // A grid: one row per scene and grid value.
     if (grid.empty()) grid[0] = "";
-    Table t{{"scene \\ " + key}, {}, {}};
+    SweepTable t{{"scene \\ " + key}, {}, {}};
     for (const auto& [i, v] : ladder) t.header.push_back(v);
     for (const SceneGroup& s : scenes)
       for (const auto& [g, gv] : grid) {
@@ -312,7 +312,7 @@ void stability_section(const std::vector<SceneGroup>& scenes, Document& doc) {
                  "cost, its own class, its energy balance |E_end - E0| / E0 (a conservation error only where the "
                  "friction law conserves energy: none or rolling) and the largest relative drift of Jellett's "
                  "integral on one surface.");
-  Table rt{{"scene", "method", "rtol", "status", "class", "steps", "rhs evals", "CPU s", "|E_end - E0| / E0",
+  SweepTable rt{{"scene", "method", "rtol", "status", "class", "steps", "rhs evals", "CPU s", "|E_end - E0| / E0",
             "Jellett drift", "inversion t"},
            {},
            {}};
@@ -389,11 +389,11 @@ Document build_doc(const std::vector<SweepRecord>& records, const std::vector<st
   for (const ReportPart& part : boundary_report(records)) {
     if (part.kind == ReportPart::H2) doc.heading(2, part.text);
     else if (part.kind == ReportPart::H3) doc.heading(3, part.text);
-    else if (part.kind == ReportPart::Tab) doc.table(to_doc(Table{part.header, part.rows}));
+    else if (part.kind == ReportPart::Tab) doc.table(to_doc(SweepTable{part.header, part.rows}));
     else doc.para(part.text);
   }
   doc.heading(2, "Setups");
-  Table st{{"setup", "engine", "fixed settings", "ladder"}, {}};
+  SweepTable st{{"setup", "engine", "fixed settings", "ladder"}, {}};
   bool any_grid = false;
   for (const SceneGroup& s : scenes)
     for (const SetupGroup& u : s.setups) any_grid = any_grid || !u.grid_key.empty();

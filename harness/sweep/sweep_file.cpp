@@ -258,13 +258,6 @@ class SweepReader : public TomlReader {
   }
 };
 
-// The scene's own message without its "FILE: " prefix, with the file named at the end.
-std::string quote_scene_error(const SceneError& e, const std::string& scene_path) {
-  std::string msg = e.what();
-  const std::string prefix = scene_path + ": ";
-  if (msg.rfind(prefix, 0) == 0) msg = msg.substr(prefix.size()) + " (scene " + scene_path + ")";
-  return msg;
-}
 
 // Which override a scene error is about: the key the scene names, matched against "KEY=VALUE".
 std::optional<size_t> override_named(const SceneError& e, const std::string& scene_path,
