@@ -130,6 +130,28 @@ TEST(SweepRecordFields, GroupsAndPartsAbsentInOlderRecordsReadAsTheirDefaults) {
   EXPECT_EQ(back.ladder_label, json(r.ladder_value).dump());
 }
 
+// The committed schema (schemas/sweep-record.schema.json, written by hand) describes every field
+// of the list and no other: a field added to the `visit` fails here until the schema has it.
+void schema_keys(const json& properties, const std::string& prefix, std::set<std::string>& out) {
+  for (const auto& [k, p] : properties.items()) {
+    out.insert(prefix + k);
+    if (k == "metrics" || k == "settings") continue;
+    if (p.contains("properties")) schema_keys(p.at("properties"), prefix + k + ".", out);
+    if (p.contains("oneOf"))
+      for (const json& alternative : p.at("oneOf"))
+        if (alternative.contains("properties")) schema_keys(alternative.at("properties"), prefix + k + ".", out);
+  }
+}
+TEST(SweepRecordFields, TheCommittedSchemaDescribesEveryListedField) {
+  std::set<std::string> listed;
+  filled_sweep_record(&listed);
+  listed.insert("format");
+  const json schema = json::parse(slurp(fs::path(TIPPE_SOURCE_DIR) / "schemas" / "sweep-record.schema.json"));
+  std::set<std::string> described;
+  schema_keys(schema.at("properties"), "", described);
+  EXPECT_EQ(described, listed);
+}
+
 // The published records (reports/sweep-*/records.jsonl) read back, and write back every field
 // they hold with the same value: the only difference a JSON diff finds is a field added since
 // they were written (the ledger's metrics), and what is written reads back to the same bytes.
