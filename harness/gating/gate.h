@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/measure/compare.h"
+#include "harness/records/fields.h"
 #include "harness/records/metric_bounds.h"
 #include "harness/records/records.h"
 #include "analytic/scene.h"
@@ -79,6 +80,34 @@ struct CheckResult {
   bool passed = false;
   double seconds = 0;  // the engine run's wall time: JUnit's time attribute only, never gated
 };
+
+// The names of GateRowKind, in its order (a row's "kind" in the JSON result).
+const std::vector<std::string>& gate_row_kind_names();
+
+// ---- the result's field lists (records/fields.h): `tippe gate --json`'s "results" follow them --
+
+// A row as the JSON result lists it (written only, never read back: the list takes it const).
+template <class V>
+void visit(const GateRow& r, V& v) {
+  v(Field("kind").one_of(gate_row_kind_names()), gate_row_kind_names().at(static_cast<size_t>(r.kind)));
+  v(Field("metric", "status, an event pairing, a metric name or run"), r.metric);
+  v(Field("value", "a threshold row's measurement; null: absent"), r.value);
+  v(Field("threshold", "a threshold row's bound on |value|"), r.limit);
+  v(Field("measured", "as shown"), r.measured);
+  v(Field("required", "as shown"), r.required);
+  v(Field("passed"), r.passed);
+  v(Field("message", "why it failed; empty when passed"), r.message);
+}
+template <class V>
+void visit(const CheckResult& r, V& v) {
+  v(Field("name"), r.name);
+  v(Field("engine"), r.engine);
+  v(Field("scene", "as written in the gate file"), r.scene);
+  v(Field("set"), r.set);
+  v(Field("passed"), r.passed);
+  v(Field("seconds", "s: the engine run's wall time, never gated"), r.seconds);
+  v(Field("rows", "status, then events (when required), then thresholds"), r.rows);
+}
 
 // Pure: the verdict of `check` on one engine's run against the reference and their metrics.
 // A threshold passes when |value| <= max; an absent value (an event error when one side lacks

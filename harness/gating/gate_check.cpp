@@ -213,10 +213,6 @@ const char* kind_name(GateRowKind k) {
   return "?";
 }
 
-json number_or_null(const std::optional<double>& v) {
-  return v && std::isfinite(*v) ? json(*v) : json(nullptr);
-}
-
 // Text and attribute values: the five XML specials, and control characters XML 1.0 cannot
 // carry at all (an engine's status detail could hold any byte).
 
@@ -358,28 +354,22 @@ std::string render_junit(const std::vector<CheckResult>& results, const std::str
   return x;
 }
 
+const std::vector<std::string>& gate_row_kind_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (GateRowKind k : {GateRowKind::Status, GateRowKind::Events, GateRowKind::Threshold, GateRowKind::Error})
+      n.emplace_back(kind_name(k));
+    return n;
+  }();
+  return names;
+}
+
 json to_json(const std::vector<CheckResult>& results) {
   json list = json::array();
   size_t failed = 0;
   for (const CheckResult& r : results) {
     failed += !r.passed;
-    json rows = json::array();
-    for (const GateRow& row : r.rows)
-      rows.push_back({{"kind", kind_name(row.kind)},
-                      {"metric", row.metric},
-                      {"value", number_or_null(row.value)},
-                      {"threshold", number_or_null(row.limit)},
-                      {"measured", row.measured},
-                      {"required", row.required},
-                      {"passed", row.passed},
-                      {"message", row.message}});
-    list.push_back({{"name", r.name},
-                    {"engine", r.engine},
-                    {"scene", r.scene},
-                    {"set", r.set},
-                    {"passed", r.passed},
-                    {"seconds", number_or_null(r.seconds)},
-                    {"rows", rows}});
+    list.push_back(JsonWriter::write(r));
   }
   return json{{"format", "tippe-gate-1"},
               {"passed", failed == 0},

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -99,6 +100,7 @@ class JsonWriter {
     for (const auto& [k, x] : v) s[k] = x;
     out[f.key()] = s;
   }
+  void operator()(const Field& f, const std::map<std::string, std::string>& v) { out[f.key()] = v; }
   template <class T, std::enable_if_t<has_visit<T>::value, int> = 0>
   void operator()(const Field& f, const T& part) { out[f.key()] = write(part); }
   template <class T>
@@ -196,6 +198,11 @@ class JsonReader {
         fail_at(where_ + f.key() + "." + k.substr(0, 40), std::string("expected a string, got ") + x.type_name());
       v.emplace_back(k, x.get<std::string>());
     }
+  }
+  void operator()(const Field& f, std::map<std::string, std::string>& v) {
+    SettingsList list;
+    (*this)(f, list);
+    v = std::map<std::string, std::string>(list.begin(), list.end());
   }
   template <class T, std::enable_if_t<has_visit<T>::value, int> = 0>
   void operator()(const Field& f, T& part) {
@@ -296,6 +303,7 @@ class SchemaBuilder {
     p["additionalProperties"] = type("string");
     put(f, std::move(p));
   }
+  void operator()(const Field& f, const std::map<std::string, std::string>&) { (*this)(f, SettingsList{}); }
   template <class T, std::enable_if_t<has_visit<T>::value, int> = 0>
   void operator()(const Field& f, const T&) { put(f, object<T>("object")); }
   template <class T>

@@ -124,25 +124,6 @@ class RecordReader {
   }
 };
 
-// Bounds of a record's counts: a point's indices are below the plan's size, repeats as in a
-// sweep file, work counters are counts (long long holds any a run can reach).
-constexpr long long kMaxCount = std::numeric_limits<long long>::max();
-
-json reference_json(const std::optional<SweepRecord::ReferenceRun>& f) {
-  if (!f) return nullptr;
-  return json{{"status", f->status},
-              {"method", f->method},
-              {"class", f->run_class},
-              {"rtol", number(f->rtol)},
-              {"cpu_seconds", number(f->cpu_seconds)},
-              {"steps", f->steps},
-              {"rhs_evaluations", f->rhs_evaluations},
-              {"energy_initial", number(f->energy_initial)},
-              {"energy_final", number(f->energy_final)},
-              {"jellett_max_relative_drift", number(f->jellett_max_relative_drift)},
-              {"final_tilt", number(f->final_tilt)}};
-}
-
 // The class a status implies when no trajectory is at hand (records from before classification).
 std::string class_of_status(const std::string& status) {
   for (const char* c : {"ok", "diverged", "clamped", "failed", "contact_lost"})
@@ -150,93 +131,195 @@ std::string class_of_status(const std::string& status) {
   return "failed";
 }
 
-json search_json(const std::optional<SweepSearch>& q) {
-  if (!q) return nullptr;
-  return json{{"criterion", q->criterion},
-              {"from", q->from},
-              {"to", q->to},
-              {"resolution", q->resolution},
-              {"per_decade", q->per_decade},
-              {"integer", q->integer}};
-}
+// Writes a sweep record's fields (its `visit`, sweep_record.h) into a JSON object: numbers that
+// are not finite as null, a part or group as an object (null when absent).
+class SweepWriter {
+ public:
+  json out = json::object();
 
-// A record's search, with the rules of `ladder.search` in a sweep file (sweep_search.h).
-SweepSearch search_from_json(const json& j) {
-  using R = RecordReader;
-  SweepSearch q;
-  q.criterion = R::string(j, "search", "criterion");
-  try {
-    parse_criterion(q.criterion);
-  } catch (const std::invalid_argument& e) {
-    R::fail("search.criterion", e.what());
+  void operator()(const SweepField& f, const std::string& v) {
+    // A label of a record from before labels: the number's text.
+    if (f.check() == SweepField::Check::label && f.is_since() && v.empty() && std::isfinite(f.value()))
+      out[f.key()] = json(f.value()).dump();
+    else
+      out[f.key()] = v;
   }
-  q.from = R::number(j, "search", "from", std::numeric_limits<double>::min());
-  q.to = R::number(j, "search", "to", q.from);
-  q.resolution = R::number(j, "search", "resolution", kMinSearchResolution);
-  if (!(q.to > q.from) || !(q.resolution <= kMaxSearchResolution) || std::log10(q.to / q.from) > kMaxSearchDecades)
-    R::fail("search", "not a search's range and resolution (expected 0 < from < to, at most " + num(kMaxSearchDecades) +
-                          " decades, resolution <= " + num(kMaxSearchResolution) + ")");
-  q.per_decade = static_cast<int>(R::integer(j, "search", "per_decade", 1, kMaxSearchPerDecade));
-  if (j.contains("integer")) {
-    const json& i = j.at("integer");
-    if (!i.is_boolean()) R::fail("search.integer", std::string("expected true or false, got ") + i.type_name());
-    q.integer = i.get<bool>();
+  void operator()(const SweepField& f, double v) { out[f.key()] = number(v); }
+  void operator()(const SweepField& f, const std::optional<double>& v) { out[f.key()] = number(v); }
+  void operator()(const SweepField& f, long long v) { out[f.key()] = v; }
+  void operator()(const SweepField& f, int v) { out[f.key()] = v; }
+  void operator()(const SweepField& f, bool v) { out[f.key()] = v; }
+  void operator()(const SweepField& f, const std::vector<std::string>& v) { out[f.key()] = v; }
+  void operator()(const SweepField& f, const std::vector<double>& v) {
+    json a = json::array();
+    for (double x : v) a.push_back(number(x));
+    out[f.key()] = a;
+  }
+  void operator()(const SweepField& f, const json& v) { out[f.key()] = v; }
+  void operator()(const SweepField& f, const Metrics& m) { out[f.key()] = to_json(m); }
+  template <class T>
+  void operator()(const SweepField& f, const std::optional<T>& part) {
+    out[f.key()] = part ? write(*part) : json(nullptr);
+  }
+  template <class Fields>
+  void group(const SweepField& f, Fields&& fields) {
+    if (f.is_null()) {
+      out[f.key()] = nullptr;
+      return;
+    }
+    SweepWriter w;
+    fields(w);
+    out[f.key()] = std::move(w.out);
+  }
+
+  template <class T>
+  static json write(const T& part) {
+    SweepWriter w;
+    visit(part, w);
+    return std::move(w.out);
+  }
+};
+
+// Reads a sweep record's fields back with the checks its `visit` names (RecordReader's rules
+// and messages: "PREFIX.KEY: reason").
+class SweepReader {
+ public:
+  using R = RecordReader;
+  SweepReader(const json& j, std::string prefix) : j_(j), prefix_(std::move(prefix)) {}
+
+  void operator()(const SweepField& f, std::string& v) {
+    const std::string where = R::dotted(prefix_, f.key());
+    switch (f.check()) {
+      case SweepField::Check::name:
+        v = R::string(j_, prefix_, f.key());
+        // Names read back become file names and report labels: the rule of names in input files.
+        if (!is_valid_name(v)) R::fail(where, "\"" + v + "\" is not a usable name (" + kNameRule + ")");
+        return;
+      case SweepField::Check::key:
+        v = R::key(j_, prefix_, f.key());
+        return;
+      case SweepField::Check::label:
+        if (f.is_since() && !j_.contains(f.key())) {
+          if (std::isnan(f.value()))
+            R::fail(where, std::string("missing (required when ") + f.value_key() + " is null)");
+          v = json(f.value()).dump();
+          return;
+        }
+        v = R::label(j_, prefix_, f.key(), f.value(), f.value_key());
+        return;
+      // Records are input: the status and the class (which names the report's CSS classes)
+      // must be known ones.
+      case SweepField::Check::status:
+        v = R::name(j_, prefix_, f.key(), {"ok", "contact_lost", "diverged", "unphysical", "clamped", "failed"});
+        return;
+      case SweepField::Check::run_class:
+        v = R::name(j_, prefix_, f.key(), {"ok", "diverged", "unphysical", "clamped", "failed", "contact_lost"});
+        return;
+      case SweepField::Check::criterion:
+        v = R::string(j_, prefix_, f.key());
+        try {
+          parse_criterion(v);
+        } catch (const std::invalid_argument& e) {
+          R::fail(where, e.what());
+        }
+        return;
+      case SweepField::Check::none:
+        v = R::string(j_, prefix_, f.key());
+        return;
+    }
+  }
+  void operator()(const SweepField& f, double& v) { v = R::number(j_, prefix_, f.key(), f.min()); }
+  void operator()(const SweepField& f, std::optional<double>& v) { v = R::optional(j_, prefix_, f.key()); }
+  void operator()(const SweepField& f, long long& v) { v = R::integer(j_, prefix_, f.key(), f.lo(), f.hi()); }
+  void operator()(const SweepField& f, int& v) { v = static_cast<int>(R::integer(j_, prefix_, f.key(), f.lo(), f.hi())); }
+  void operator()(const SweepField& f, bool& v) {
+    if (f.is_since() && !j_.contains(f.key())) return;
+    const json& b = R::at(j_, prefix_, f.key());
+    if (!b.is_boolean()) R::fail(R::dotted(prefix_, f.key()), std::string("expected true or false, got ") + b.type_name());
+    v = b.get<bool>();
+  }
+  void operator()(const SweepField& f, std::vector<std::string>& v) {
+    const std::string where = R::dotted(prefix_, f.key());
+    const json& a = R::at(j_, prefix_, f.key());
+    if (!a.is_array()) R::fail(where, std::string("expected an array, got ") + a.type_name());
+    v.clear();
+    for (size_t i = 0; i < a.size(); ++i) {
+      if (!a[i].is_string()) R::fail(where + "[" + std::to_string(i) + "]", std::string("expected a string, got ") + a[i].type_name());
+      v.push_back(a[i].get<std::string>());
+    }
+  }
+  // The CPU time of every repeat: numbers or null, at most kMaxRepeats.
+  void operator()(const SweepField& f, std::vector<double>& v) {
+    const std::string where = R::dotted(prefix_, f.key());
+    const json& a = R::at(j_, prefix_, f.key());
+    if (!a.is_array() || a.size() > static_cast<size_t>(kMaxRepeats))
+      R::fail(where, "expected an array of at most " + std::to_string(kMaxRepeats) + " numbers");
+    v.clear();
+    for (const json& c : a) {
+      if (!c.is_null() && !c.is_number()) R::fail(where, std::string("expected numbers, got ") + c.type_name());
+      v.push_back(c.is_null() ? std::nan("") : c.get<double>());
+    }
+  }
+  // Settings: an object whose every value is a setting's text as the engine listed it.
+  void operator()(const SweepField& f, json& v) {
+    const std::string where = R::dotted(prefix_, f.key());
+    v = R::at(j_, prefix_, f.key());
+    if (!v.is_object()) R::fail(where, std::string("expected an object, got ") + v.type_name());
+    for (const auto& [k, x] : v.items())
+      if (!x.is_string()) R::fail(where + "." + utf8_replaced(k.substr(0, 40)), std::string("expected a string, got ") + x.type_name());
+  }
+  void operator()(const SweepField& f, Metrics& m) {
+    try {
+      m = metrics_from_json(R::at(j_, prefix_, f.key()));
+    } catch (const json::exception& e) {
+      // metrics_from_json names the field in its own words after json's "[json.exception...] ".
+      std::string why = e.what();
+      if (const size_t close = why.find("] "); close != std::string::npos) why.erase(0, close + 2);
+      R::fail(R::dotted(prefix_, f.key()), why);
+    }
+  }
+  // A part absent or null in the record: none.
+  template <class T>
+  void operator()(const SweepField& f, std::optional<T>& part) {
+    if (!j_.contains(f.key()) || j_.at(f.key()).is_null()) {
+      part = std::nullopt;
+      return;
+    }
+    T p{};
+    SweepReader r(j_.at(f.key()), R::dotted(prefix_, f.key()));
+    visit(p, r);
+    check(p);
+    part = p;
+  }
+  // A group: absent (since) or null (nullable) reads nothing.
+  template <class Fields>
+  void group(const SweepField& f, Fields&& fields) {
+    if (f.is_since() && !j_.contains(f.key())) return;
+    if (f.nullable() && (!j_.contains(f.key()) || j_.at(f.key()).is_null())) return;
+    SweepReader r(R::at(j_, prefix_, f.key()), R::dotted(prefix_, f.key()));
+    fields(r);
+  }
+
+ private:
+  static void check(const SweepRecord::ReferenceRun&) {}
+  // A search's range as a whole, with the rules of `ladder.search` (sweep_search.h).
+  static void check(const SweepSearch& q) {
+    if (!(q.to > q.from) || !(q.resolution <= kMaxSearchResolution) || std::log10(q.to / q.from) > kMaxSearchDecades)
+      R::fail("search", "not a search's range and resolution (expected 0 < from < to, at most " + num(kMaxSearchDecades) +
+                            " decades, resolution <= " + num(kMaxSearchResolution) + ")");
     if (q.integer && (q.from != std::floor(q.from) || q.to != std::floor(q.to)))
       R::fail("search.integer", "from and to of an integer search are whole numbers");
   }
-  return q;
-}
+  const json& j_;
+  std::string prefix_;
+};
 
 }  // namespace
 
 json to_json(const SweepRecord& r) {
-  json cpu = json::array();
-  for (double c : r.cpu_seconds_repeats) cpu.push_back(number(c));
-  return json{
-      {"format", "tippe-sweep-record-1"},
-      {"point_id", r.point_id},
-      {"scene", r.scene},
-      {"scene_file", r.scene_file},
-      {"physics_hash", r.physics_hash},
-      {"scene_index", r.scene_index},
-      {"setup", r.setup},
-      {"engine", r.engine},
-      {"set", r.set},
-      {"ladder_key", r.ladder_key},
-      {"ladder_value", number(r.ladder_value)},
-      {"ladder_label", !r.ladder_label.empty() || !std::isfinite(r.ladder_value) ? r.ladder_label
-                                                                                 : json(r.ladder_value).dump()},
-      {"setup_index", r.setup_index},
-      {"ladder_index", r.ladder_index},
-      {"grid", r.grid_key.empty() ? json(nullptr)
-                                  : json{{"key", r.grid_key},
-                                         {"value", number(r.grid_value)},
-                                         {"label", r.grid_label},
-                                         {"index", r.grid_index}}},
-      {"repeats", r.repeats},
-      {"duration", number(r.duration)},
-      {"status", r.status},
-      {"status_time", number(r.status_time)},
-      {"status_detail", r.status_detail},
-      {"inversion_time", number(r.inversion_time)},
-      {"stem_contact_time", number(r.stem_contact_time)},
-      {"reference_inversion_time", number(r.reference_inversion_time)},
-      {"reference_stem_contact_time", number(r.reference_stem_contact_time)},
-      {"metrics", to_json(r.metrics)},
-      {"work",
-       {{"cpu_seconds", number(r.cpu_seconds)},
-        {"cpu_seconds_repeats", cpu},
-        {"wall_seconds", number(r.wall_seconds)},
-        {"steps", r.steps},
-        {"rhs_evaluations", r.rhs_evaluations},
-        {"solver_iterations", r.solver_iterations}}},
-      {"engine_version", r.engine_version},
-      {"git_commit", r.git_commit},
-      {"settings", r.settings},
-      {"class", {{"name", r.run_class}, {"time", number(r.class_time)}, {"reason", r.class_reason}}},
-      {"reference", reference_json(r.reference)},
-      {"search", search_json(r.search)},
-  };
+  json j = SweepWriter::write(r);
+  j["format"] = "tippe-sweep-record-1";
+  return j;
 }
 
 SweepRecord sweep_record_from_json(const json& j) {
@@ -244,108 +327,10 @@ SweepRecord sweep_record_from_json(const json& j) {
   const std::string format = R::string(j, "", "format");
   if (format != "tippe-sweep-record-1")
     R::fail("format", "unknown record format \"" + utf8_replaced(format.substr(0, 40)) + "\" (expected tippe-sweep-record-1)");
-  const long long max_index = static_cast<long long>(kMaxSweepPoints) - 1;
   SweepRecord r;
-  r.point_id = R::string(j, "", "point_id");
-  r.scene = R::string(j, "", "scene");
-  r.scene_file = R::string(j, "", "scene_file");
-  r.physics_hash = R::string(j, "", "physics_hash");
-  r.scene_index = R::integer(j, "", "scene_index", 0, max_index);
-  r.setup = R::string(j, "", "setup");
-  r.engine = R::string(j, "", "engine");
-  // Names read back become file names and report labels: the rule of names in input files.
-  for (const auto& [key, name] : {std::pair<const char*, const std::string*>{"scene", &r.scene},
-                                  {"setup", &r.setup},
-                                  {"engine", &r.engine}})
-    if (!is_valid_name(*name)) R::fail(key, "\"" + *name + "\" is not a usable name (" + kNameRule + ")");
-  const json& set = R::at(j, "", "set");
-  if (!set.is_array()) R::fail("set", std::string("expected an array, got ") + set.type_name());
-  for (size_t i = 0; i < set.size(); ++i) {
-    if (!set[i].is_string()) R::fail("set[" + std::to_string(i) + "]", std::string("expected a string, got ") + set[i].type_name());
-    r.set.push_back(set[i].get<std::string>());
-  }
-  r.ladder_key = R::key(j, "", "ladder_key");
-  r.ladder_value = R::number(j, "", "ladder_value");
-  // Records from before categorical ladders carry only the number.
-  if (j.contains("ladder_label"))
-    r.ladder_label = R::label(j, "", "ladder_label", r.ladder_value, "ladder_value");
-  else if (std::isnan(r.ladder_value))
-    R::fail("ladder_label", "missing (required when ladder_value is null)");
-  else
-    r.ladder_label = json(r.ladder_value).dump();
-  r.setup_index = R::integer(j, "", "setup_index", 0, max_index);
-  r.ladder_index = R::integer(j, "", "ladder_index", 0, max_index);
-  if (j.contains("grid") && !j.at("grid").is_null()) {
-    const json& g = j.at("grid");
-    r.grid_key = R::key(g, "grid", "key");
-    r.grid_value = R::number(g, "grid", "value");
-    r.grid_label = R::label(g, "grid", "label", r.grid_value, "grid.value");
-    r.grid_index = R::integer(g, "grid", "index", 0, max_index);
-  }
-  r.repeats = R::integer(j, "", "repeats", 1, kMaxRepeats);
-  r.duration = R::number(j, "", "duration", 0.0);
-  // Records are input: the status and the class (which names the report's CSS classes) must be
-  // known ones.
-  r.status = R::name(j, "", "status", {"ok", "contact_lost", "diverged", "unphysical", "clamped", "failed"});
-  r.status_time = R::number(j, "", "status_time");
-  r.status_detail = R::string(j, "", "status_detail");
-  r.inversion_time = R::optional(j, "", "inversion_time");
-  r.stem_contact_time = R::optional(j, "", "stem_contact_time");
-  r.reference_inversion_time = R::optional(j, "", "reference_inversion_time");
-  r.reference_stem_contact_time = R::optional(j, "", "reference_stem_contact_time");
-  try {
-    r.metrics = metrics_from_json(R::at(j, "", "metrics"));
-  } catch (const json::exception& e) {
-    // metrics_from_json names the field in its own words after json's "[json.exception...] ".
-    std::string why = e.what();
-    if (const size_t close = why.find("] "); close != std::string::npos) why.erase(0, close + 2);
-    R::fail("metrics", why);
-  }
-  const json& w = R::at(j, "", "work");
-  r.cpu_seconds = R::number(w, "work", "cpu_seconds", 0.0);
-  const json& cpu = R::at(w, "work", "cpu_seconds_repeats");
-  if (!cpu.is_array() || cpu.size() > static_cast<size_t>(kMaxRepeats))
-    R::fail("work.cpu_seconds_repeats", "expected an array of at most " + std::to_string(kMaxRepeats) + " numbers");
-  for (const json& c : cpu) {
-    if (!c.is_null() && !c.is_number()) R::fail("work.cpu_seconds_repeats", std::string("expected numbers, got ") + c.type_name());
-    r.cpu_seconds_repeats.push_back(c.is_null() ? std::nan("") : c.get<double>());
-  }
-  r.wall_seconds = R::number(w, "work", "wall_seconds", 0.0);
-  r.steps = R::integer(w, "work", "steps", 0, kMaxCount);
-  r.rhs_evaluations = R::integer(w, "work", "rhs_evaluations", 0, kMaxCount);
-  r.solver_iterations = R::integer(w, "work", "solver_iterations", 0, kMaxCount);
-  r.engine_version = R::string(j, "", "engine_version");
-  r.git_commit = R::string(j, "", "git_commit");
-  r.settings = R::at(j, "", "settings");
-  if (!r.settings.is_object()) R::fail("settings", std::string("expected an object, got ") + r.settings.type_name());
-  // A setting's value is its text as the engine listed it.
-  for (const auto& [k, v] : r.settings.items())
-    if (!v.is_string()) R::fail("settings." + utf8_replaced(k.substr(0, 40)), std::string("expected a string, got ") + v.type_name());
-  if (j.contains("class")) {
-    const json& c = R::at(j, "", "class");
-    r.run_class = R::name(c, "class", "name", {"ok", "diverged", "unphysical", "clamped", "failed", "contact_lost"});
-    r.class_time = R::number(c, "class", "time");
-    r.class_reason = R::string(c, "class", "reason");
-  } else {
-    r.run_class = class_of_status(r.status);
-  }
-  if (j.contains("reference") && !j.at("reference").is_null()) {
-    const json& x = j.at("reference");
-    SweepRecord::ReferenceRun f;
-    f.status = R::name(x, "reference", "status", {"ok", "contact_lost", "diverged", "unphysical", "clamped", "failed"});
-    f.method = R::string(x, "reference", "method");
-    f.run_class = R::name(x, "reference", "class", {"ok", "diverged", "unphysical", "clamped", "failed", "contact_lost"});
-    f.rtol = R::number(x, "reference", "rtol", 0.0);
-    f.cpu_seconds = R::number(x, "reference", "cpu_seconds", 0.0);
-    f.steps = R::integer(x, "reference", "steps", 0, kMaxCount);
-    f.rhs_evaluations = R::integer(x, "reference", "rhs_evaluations", 0, kMaxCount);
-    f.energy_initial = R::number(x, "reference", "energy_initial");
-    f.energy_final = R::number(x, "reference", "energy_final");
-    f.jellett_max_relative_drift = R::number(x, "reference", "jellett_max_relative_drift");
-    f.final_tilt = R::number(x, "reference", "final_tilt");
-    r.reference = f;
-  }
-  if (j.contains("search") && !j.at("search").is_null()) r.search = search_from_json(j.at("search"));
+  SweepReader reader(j, "");
+  visit(r, reader);
+  if (!j.contains("class")) r.run_class = class_of_status(r.status);
   return r;
 }
 

@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -100,6 +101,155 @@ struct SweepRecord {
   std::optional<ReferenceRun> reference;  // absent in records written before it existed
   std::optional<SweepSearch> search;      // the point's boundary search ("search": null without one)
 };
+
+// Limits of `ladder.search`. The resolution is in log10 units: 1e-3 is a factor of 1.0023, finer
+// than any step a run could tell apart from its neighbour, and far above the 6 significant digits
+// the values are written with; above 1 (a decade) a bracket says little a ladder would not.
+constexpr double kMinSearchResolution = 1e-3, kMaxSearchResolution = 1.0;
+constexpr int kMaxSearchPerDecade = 20;
+constexpr double kMaxSearchDecades = 20;
+
+// ---- the sweep record's field list ------------------------------------------------------------
+
+// What a sweep record's `visit` says of one field: its JSON key and the check its reader makes
+// (records are input: every field is checked, an error names the dotted key). The sweep record
+// keeps its own list rather than records/fields.h's because its JSON groups some members
+// ("work", "grid", "class") and its reader's messages are those of a sweep file's.
+class SweepField {
+ public:
+  enum class Check { none, name, key, label, status, run_class, criterion };
+  SweepField(const char* key) : key_(key) {}
+  // Absent (or null) in records written before it: the reader keeps the default (a label: the
+  // number's text; a group: nothing read).
+  SweepField since() const { SweepField f = *this; f.since_ = true; return f; }
+  // A name that becomes a file name and a report label (is_valid_name).
+  SweepField name() const { return with(Check::name); }
+  // A setting key ("engines.ode.timestep"), the rule of names.
+  SweepField setting_key() const { return with(Check::key); }
+  // An axis value's text: a name or a number equal to `value` (named `value_key` in messages).
+  SweepField label_of(const char* value_key, double value) const {
+    SweepField f = with(Check::label);
+    f.value_key_ = value_key;
+    f.value_ = value;
+    return f;
+  }
+  SweepField status() const { return with(Check::status); }        // run_status_names()
+  SweepField run_class() const { return with(Check::run_class); }  // a stability-map class
+  SweepField criterion() const { return with(Check::criterion); }  // parse_criterion's form
+  // An integer in [lo, hi]; a number >= lo.
+  SweepField range(long long lo, long long hi) const { SweepField f = *this; f.lo_ = lo; f.hi_ = hi; return f; }
+  SweepField at_least(double lo) const { SweepField f = *this; f.min_ = lo; return f; }
+  // A group written as null (and null read as nothing) when `null` holds.
+  SweepField null_if(bool null) const { SweepField f = *this; f.null_ = null; f.nullable_ = true; return f; }
+
+  const char* key() const { return key_; }
+  bool is_since() const { return since_; }
+  Check check() const { return check_; }
+  const char* value_key() const { return value_key_; }
+  double value() const { return value_; }
+  long long lo() const { return lo_; }
+  long long hi() const { return hi_; }
+  double min() const { return min_; }
+  bool nullable() const { return nullable_; }
+  bool is_null() const { return null_; }
+
+ private:
+  SweepField with(Check c) const { SweepField f = *this; f.check_ = c; return f; }
+  const char* key_;
+  bool since_ = false, nullable_ = false, null_ = false;
+  Check check_ = Check::none;
+  const char* value_key_ = "";
+  double value_ = 0;
+  long long lo_ = 0, hi_ = std::numeric_limits<long long>::max();
+  double min_ = -std::numeric_limits<double>::infinity();
+};
+
+// A point's indices are below the plan's size; work counters are counts.
+constexpr long long kMaxSweepIndex = static_cast<long long>(kMaxSweepPoints) - 1;
+constexpr long long kMaxSweepCount = std::numeric_limits<long long>::max();
+
+// The fields of records.jsonl's line but "format" (to_json writes it, the reader checks it
+// first), in the order the reader checks them (a record with several faults names the first).
+// `v(field, member)` for a field, `v.group(field, fields)` for a JSON object that groups members
+// of the struct (fields: a callable taking the visitor of the group's own fields).
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, SweepRecord::ReferenceRun>> visit(R& f, V& v) {
+  v(SweepField("status").status(), f.status);
+  v(SweepField("method"), f.method);
+  v(SweepField("class").run_class(), f.run_class);
+  v(SweepField("rtol").at_least(0.0), f.rtol);
+  v(SweepField("cpu_seconds").at_least(0.0), f.cpu_seconds);
+  v(SweepField("steps").range(0, kMaxSweepCount), f.steps);
+  v(SweepField("rhs_evaluations").range(0, kMaxSweepCount), f.rhs_evaluations);
+  v(SweepField("energy_initial"), f.energy_initial);
+  v(SweepField("energy_final"), f.energy_final);
+  v(SweepField("jellett_max_relative_drift"), f.jellett_max_relative_drift);
+  v(SweepField("final_tilt"), f.final_tilt);
+}
+// The rules of `ladder.search` in a sweep file (sweep_search.h); the reader then checks the
+// range as a whole (check_search).
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, SweepSearch>> visit(R& q, V& v) {
+  v(SweepField("criterion").criterion(), q.criterion);
+  v(SweepField("from").at_least(std::numeric_limits<double>::min()), q.from);
+  v(SweepField("to").at_least(q.from), q.to);
+  v(SweepField("resolution").at_least(kMinSearchResolution), q.resolution);
+  v(SweepField("per_decade").range(1, kMaxSearchPerDecade), q.per_decade);
+  v(SweepField("integer").since(), q.integer);
+}
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, SweepRecord>> visit(R& r, V& v) {
+  v(SweepField("point_id"), r.point_id);
+  v(SweepField("scene").name(), r.scene);
+  v(SweepField("scene_file"), r.scene_file);
+  v(SweepField("physics_hash"), r.physics_hash);
+  v(SweepField("scene_index").range(0, kMaxSweepIndex), r.scene_index);
+  v(SweepField("setup").name(), r.setup);
+  v(SweepField("engine").name(), r.engine);
+  v(SweepField("set"), r.set);
+  v(SweepField("ladder_key").setting_key(), r.ladder_key);
+  v(SweepField("ladder_value"), r.ladder_value);  // NaN (null): a value that is not a number
+  // Records from before categorical ladders carry only the number.
+  v(SweepField("ladder_label").label_of("ladder_value", r.ladder_value).since(), r.ladder_label);
+  v(SweepField("setup_index").range(0, kMaxSweepIndex), r.setup_index);
+  v(SweepField("ladder_index").range(0, kMaxSweepIndex), r.ladder_index);
+  v.group(SweepField("grid").null_if(r.grid_key.empty()), [&](auto& g) {
+    g(SweepField("key").setting_key(), r.grid_key);
+    g(SweepField("value"), r.grid_value);
+    g(SweepField("label").label_of("grid.value", r.grid_value), r.grid_label);
+    g(SweepField("index").range(0, kMaxSweepIndex), r.grid_index);
+  });
+  v(SweepField("repeats").range(1, kMaxRepeats), r.repeats);
+  v(SweepField("duration").at_least(0.0), r.duration);
+  v(SweepField("status").status(), r.status);
+  v(SweepField("status_time"), r.status_time);
+  v(SweepField("status_detail"), r.status_detail);
+  v(SweepField("inversion_time"), r.inversion_time);
+  v(SweepField("stem_contact_time"), r.stem_contact_time);
+  v(SweepField("reference_inversion_time"), r.reference_inversion_time);
+  v(SweepField("reference_stem_contact_time"), r.reference_stem_contact_time);
+  v(SweepField("metrics"), r.metrics);
+  v.group(SweepField("work"), [&](auto& g) {
+    g(SweepField("cpu_seconds").at_least(0.0), r.cpu_seconds);
+    g(SweepField("cpu_seconds_repeats"), r.cpu_seconds_repeats);
+    g(SweepField("wall_seconds").at_least(0.0), r.wall_seconds);
+    g(SweepField("steps").range(0, kMaxSweepCount), r.steps);
+    g(SweepField("rhs_evaluations").range(0, kMaxSweepCount), r.rhs_evaluations);
+    g(SweepField("solver_iterations").range(0, kMaxSweepCount), r.solver_iterations);
+  });
+  v(SweepField("engine_version"), r.engine_version);
+  v(SweepField("git_commit"), r.git_commit);
+  v(SweepField("settings"), r.settings);  // every value a string
+  // Absent in records written before classification: the class the status implies.
+  v.group(SweepField("class").since(), [&](auto& g) {
+    g(SweepField("name").run_class(), r.run_class);
+    g(SweepField("time"), r.class_time);
+    g(SweepField("reason"), r.class_reason);
+  });
+  v(SweepField("reference").since(), r.reference);
+  v(SweepField("search").since(), r.search);
+}
+
 nlohmann::json to_json(const SweepRecord& r);
 // Every field checked for its type and range (indices 0 <= i < kMaxSweepPoints, repeats as in a
 // sweep file, counts >= 0, times and costs numbers or null, the class a known name, keys and
@@ -160,12 +310,6 @@ bool larger_is_softer(const std::string& ladder_key);
 std::string ladder_text(const SweepRecord& r);
 std::string grid_text(const SweepRecord& r);
 
-// Limits of `ladder.search`. The resolution is in log10 units: 1e-3 is a factor of 1.0023, finer
-// than any step a run could tell apart from its neighbour, and far above the 6 significant digits
-// the values are written with; above 1 (a decade) a bracket says little a ladder would not.
-constexpr double kMinSearchResolution = 1e-3, kMaxSearchResolution = 1.0;
-constexpr int kMaxSearchPerDecade = 20;
-constexpr double kMaxSearchDecades = 20;
 // ---- the one criterion of "safe" --------------------------------------------------------------
 
 // Whether a point is a setting a user may rely on. Every reader that decides it calls

@@ -38,13 +38,44 @@ class Scene(Record):
 
 class RunResult(Record):
     trajectory: Trajectory
+    format: str
     scene: str
+    scene_file: str
+    scene_hash: str
+    scene_spec: dict[str, Any]
     engine: str
+    engine_version: str
     status: str
+    status_time: float | None
+    status_detail: str
     inversion_time: float | None
-    final_time: float
-    final_tilt: float
+    stem_contact_time: float | None
     samples: int
+    final_time: float | None
+    final_tilt: float | None
+    energy_initial: float | None
+    energy_final: float | None
+    jellett_initial: float | None
+    jellett_max_relative_drift: float | None
+    jellett_drift_ball: float | None
+    jellett_drift_stem: float | None
+    min_normal_force: float | None
+    friction_work: float | None
+    normal_work: float | None
+    drilling_work: float | None
+    impact_energy: float | None
+    elastic_energy_max: float | None
+    numerical_energy_max: float | None
+    numerical_energy_final: float | None
+    ledger_not_available: list[str]
+    ledger_at_inversion: Record | None
+    mass_properties: Record
+    inversion_possible: bool
+    work: Record
+    events: list[Record]
+    settings: dict[str, str]
+    notes: list[str]
+    provenance: Record
 
 class Comparison(Record):
     trajectories: dict[str, Trajectory]

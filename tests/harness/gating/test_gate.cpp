@@ -505,6 +505,39 @@ TEST(GateRender, JsonCounts) {
   EXPECT_TRUE(to_json(std::vector<CheckResult>{}).at("passed").get<bool>());
 }
 
+// The JSON result writes exactly the fields of CheckResult's and GateRow's field lists (gate.h),
+// and the committed schema (schemas/gate-result.schema.json, written by hand) describes each of
+// them and no other: a field added to a list fails here until the schema has it.
+TEST(GateRender, JsonResultIsTheFieldListsAndTheSchemaDescribesThem) {
+  const auto keys = [](const std::vector<FieldInfo>& fields) {
+    std::set<std::string> k;
+    for (const FieldInfo& f : fields) k.insert(f.key);
+    return k;
+  };
+  const auto keys_of = [](const json& object) {
+    std::set<std::string> k;
+    for (const auto& [key, v] : object.items()) k.insert(key);
+    return k;
+  };
+  const std::set<std::string> result_keys = keys(field_list<CheckResult>()), row_keys = keys(field_list<GateRow>());
+  const json j = to_json(mixed_results());
+  size_t rows = 0;
+  for (const json& r : j.at("results")) {
+    EXPECT_EQ(keys_of(r), result_keys);
+    for (const json& row : r.at("rows")) {
+      EXPECT_EQ(keys_of(row), row_keys);
+      ++rows;
+    }
+  }
+  EXPECT_GT(rows, 3u);
+  const json schema = json::parse(slurp(fs::path(TIPPE_SOURCE_DIR) / "schemas" / "gate-result.schema.json"));
+  const json& result = schema.at("properties").at("results").at("items");
+  EXPECT_EQ(keys_of(result.at("properties")), result_keys);
+  const json& row = result.at("properties").at("rows").at("items");
+  EXPECT_EQ(keys_of(row.at("properties")), row_keys);
+  EXPECT_EQ(row.at("properties").at("kind").at("enum"), json(gate_row_kind_names()));
+}
+
 // ---- gate files -------------------------------------------------------------------------------
 
 namespace {
