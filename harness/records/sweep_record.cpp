@@ -182,10 +182,10 @@ class SweepWriter {
 
 // Reads a sweep record's fields back with the checks its `visit` names (RecordReader's rules
 // and messages: "PREFIX.KEY: reason").
-class SweepReader {
+class SweepRecordReader {
  public:
   using R = RecordReader;
-  SweepReader(const json& j, std::string prefix) : j_(j), prefix_(std::move(prefix)) {}
+  SweepRecordReader(const json& j, std::string prefix) : j_(j), prefix_(std::move(prefix)) {}
 
   void operator()(const SweepField& f, std::string& v) {
     const std::string where = R::dotted(prefix_, f.key());
@@ -286,7 +286,7 @@ class SweepReader {
       return;
     }
     T p{};
-    SweepReader r(j_.at(f.key()), R::dotted(prefix_, f.key()));
+    SweepRecordReader r(j_.at(f.key()), R::dotted(prefix_, f.key()));
     visit(p, r);
     check(p);
     part = p;
@@ -296,7 +296,7 @@ class SweepReader {
   void group(const SweepField& f, Fields&& fields) {
     if (f.is_since() && !j_.contains(f.key())) return;
     if (f.nullable() && (!j_.contains(f.key()) || j_.at(f.key()).is_null())) return;
-    SweepReader r(R::at(j_, prefix_, f.key()), R::dotted(prefix_, f.key()));
+    SweepRecordReader r(R::at(j_, prefix_, f.key()), R::dotted(prefix_, f.key()));
     fields(r);
   }
 
@@ -328,7 +328,7 @@ SweepRecord sweep_record_from_json(const json& j) {
   if (format != "tippe-sweep-record-1")
     R::fail("format", "unknown record format \"" + utf8_replaced(format.substr(0, 40)) + "\" (expected tippe-sweep-record-1)");
   SweepRecord r;
-  SweepReader reader(j, "");
+  SweepRecordReader reader(j, "");
   visit(r, reader);
   if (!j.contains("class")) r.run_class = class_of_status(r.status);
   return r;
