@@ -8,6 +8,7 @@
 // vanishes: n . (a_G + dw/dt x R_C + w x (w x r_GO)) = 0, with r_GO the vector from G to the
 // centre of the contacting sphere (the lowest point moves over the sphere, the centre does not).
 #include "analytic/contact_dynamics.h"
+#include "analytic/detail/contact_unknowns.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -18,9 +19,9 @@ namespace tippe {
 
 namespace {
 
-constexpr int kMaxUnknowns = 8;  // 2 contacts x (normal + 2 tangential + drilling)
-using MatN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns, kMaxUnknowns>;
-using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
+using contact_detail::kMaxUnknowns;
+using contact_detail::MatN;
+using contact_detail::VecN;
 
 struct Column {  // generalized force per unit of an unknown
   Vec3 f, tau;

@@ -1,5 +1,6 @@
 // Impulses at the contacts: touchdown impacts with their friction laws, the normal projections, and stopping a contact.
 #include "analytic/contact_dynamics.h"
+#include "analytic/detail/contact_unknowns.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -9,9 +10,9 @@ namespace tippe {
 
 namespace {
 
-constexpr int kMaxUnknowns = 8;  // as in contact_dynamics.cpp: at most 7 impulse unknowns here
-using MatN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns, kMaxUnknowns>;
-using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
+using contact_detail::kMaxUnknowns;
+using contact_detail::MatN;
+using contact_detail::VecN;
 
 }  // namespace
 
