@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/io/text.h"
 #include "harness/report/ledger_terms.h"
 #include "harness/report/report_text.h"
 
@@ -15,23 +16,6 @@ namespace {
 
 using nlohmann::json;
 using namespace report_text;
-
-std::string xml_escaped(const std::string& s) {
-  std::string out;
-  for (const char ch : s) {
-    switch (ch) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default:
-        // Control characters have no place in a name drawn as text.
-        out += static_cast<unsigned char>(ch) < 0x20 ? '_' : ch;
-    }
-  }
-  return out;
-}
 
 struct Bar {
   std::string name;
@@ -110,7 +94,7 @@ std::string ledger_chart_svg(const json& c) {
     const Bar& b = bars[i];
     const int y = top + row * static_cast<int>(i) + (row - bar_h) / 2;
     s += "<text x=\"" + std::to_string(left - 8) + "\" y=\"" + std::to_string(y + bar_h - 4) +
-         "\" text-anchor=\"end\">" + xml_escaped(b.name) + "</text>\n";
+         "\" text-anchor=\"end\">" + markup_escape(b.name) + "</text>\n";
     double neg = 0.0, pos = 0.0;
     for (const auto& [t, v] : b.parts) {
       if (v == 0 || !std::isfinite(v)) continue;
@@ -118,7 +102,7 @@ std::string ledger_chart_svg(const json& c) {
       (v < 0 ? neg : pos) += v;
       s += "<rect class=\"term\" data-term=\"" + std::string(t->key) + "\" data-value=\"" + fmt(v, "%.6g") + "\" x=\"" +
            num_text(x_of(from)) + "\" y=\"" + std::to_string(y) + "\" width=\"" + num_text(x_of(to) - x_of(from)) +
-           "\" height=\"" + std::to_string(bar_h) + "\" fill=\"" + t->colour + "\"><title>" + xml_escaped(b.name) + ": " +
+           "\" height=\"" + std::to_string(bar_h) + "\" fill=\"" + t->colour + "\"><title>" + markup_escape(b.name) + ": " +
            t->label + " " + fmt(v, "%.3g") + " E0</title></rect>\n";
     }
     if (std::isfinite(b.total)) {
