@@ -1,6 +1,7 @@
 // The comparison record (comparison.json): the reference, every engine's run and metrics, the reference's self-check.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -100,7 +101,12 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Metrics>> visit(R& m, V&
   v(Field("energy_final_ratio", "E_final / E0 of the engine"), m.energy_final_ratio);
   v(Field("energy_gain_events", "count"), m.energy_gain_events);
   v(Field("energy_max_gain", "/ E0"), m.energy_max_gain);
-  static const std::vector<std::string> rules = {"ledger", "total"};
+  // Sorted in the schema, which a new rule then extends in one place.
+  static const std::vector<std::string> rules = [] {
+    std::vector<std::string> r = energy_gain_rule_names();
+    std::sort(r.begin(), r.end());
+    return r;
+  }();
   v(Field("energy_gain_rule",
           "how energy_gain_events and energy_max_gain counted energy (harness/measure/metrics.h): ledger (energy "
           "created by the ledger's account) or total (E); absent in records written before it")
