@@ -226,7 +226,9 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Metrics>> visit(R& m, V&
         .minimum(0)
         .not_bounded("a setting of the bench, not a measurement"),
     m.event_min_dwell);
-  v(Field("event_alignment", "the first 20 aligned pairs (kMaxAlignedEventRowsKept)").since(), m.event_alignment);
+  static const std::string alignment_doc =
+      "the first " + std::to_string(kMaxAlignedEventRowsKept) + " aligned pairs (kMaxAlignedEventRowsKept)";
+  v(Field("event_alignment", alignment_doc.c_str()).since(), m.event_alignment);
   v(Field("event_alignment_rows", "how many aligned pairs the whole alignment has")
         .since()
         .minimum(0)

@@ -83,7 +83,7 @@ Cell event_error_cell(const json& comparison, const json& metrics, const std::st
   const double rel_err = num(metrics, (key + "_time_rel_error").c_str());
   std::string text = fmt(abs_err, "%+.3g");
   if (std::isfinite(rel_err)) text += " (" + fmt(100 * rel_err, "%+.2g") + " %)";
-  return {text, grade_against(comparison, key + "_time_rel_error", rel_err, 0.01, 0.10)};
+  return {text, grade_against(comparison, key + "_time_rel_error", rel_err, kEventTimeGreenBand, kEventTimeAmberBand)};
 }
 
 std::string cpu_text(const json& summary, bool cached) {
