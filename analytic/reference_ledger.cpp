@@ -157,7 +157,8 @@ void ReferenceModel::Impl::accumulate_friction_work(double a, double b) {
   std::array<Vec3, 5> nodes;
   ledger.add_contact_work(friction_work(a, b, &nodes));
   ledger_t = b;
-  // The end's power is filled in by step(), from the check point or the event at b.
+  // The end's power is filled in by close_power_fit, once step() has it (the check point or the
+  // event at b).
   power_fit.valid = false;
   power_fit.a = a;
   power_fit.b = b;
@@ -165,6 +166,11 @@ void ReferenceModel::Impl::accumulate_friction_work(double a, double b) {
   fit_misses = 0;
   power_fit.p[0] = p_start;
   std::copy(nodes.begin(), nodes.end(), power_fit.p.begin() + 1);
+}
+
+void ReferenceModel::Impl::close_power_fit(const Vec3& p_end) {
+  power_fit.p[6] = p_end;
+  power_fit.valid = true;
 }
 
 EnergyLedger ReferenceModel::energy_ledger() const {

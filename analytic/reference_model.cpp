@@ -223,11 +223,10 @@ void ReferenceModel::Impl::step() {
     const ContactForces fb = forces_at(yb, mode);
     note_forces(fb);
     track_graze(graze_last);
-    power_fit.p[6] = contact_power(yb, fb);
+    close_power_fit(contact_power(yb, fb));
   } else {
-    power_fit.p[6] = p_chk[n_checks];
+    close_power_fit(p_chk[n_checks]);
   }
-  power_fit.valid = true;
   if (best >= 0) {
     pending = true;
     pending_fn = fns[best];

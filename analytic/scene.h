@@ -66,6 +66,14 @@ struct InitialSpec {
   double height = 0.0;                     // lowest point of the ball above the floor (> 0: start in flight)
 };
 
+// The values RunSpec::energy_gain_rule may take, the default first (harness/measure/metrics.h's
+// EnergyGainRule, in this order): "total" (the rise of E itself) and "ledger" (the energy the
+// run's ledger says was created, not released from a contact's store).
+inline const std::vector<std::string>& energy_gain_rule_names() {
+  static const std::vector<std::string> names = {"total", "ledger"};
+  return names;
+}
+
 struct RunSpec {
   double duration = 1.0;
   double sample_interval = 1e-3;
@@ -79,11 +87,11 @@ struct RunSpec {
   // time on the two part (the reference's self-check, harness/measure/self_check.h); false skips it.
   bool self_check = true;
   // How the bench counts an energy rise in a dissipative scene (harness/measure/metrics.h,
-  // docs/energy-ledger.md): "total" (the rise of E itself: the default, kDefaultEnergyGainRule) or
-  // "ledger" (the energy the run's ledger says was created, not released from a contact's store).
-  // A choice of the bench, not physics: it moves no run, only the class and the gain metrics, and
-  // is named beside them (energy_gain_rule in every comparison and sweep record).
-  std::string energy_gain_rule = "total";
+  // docs/energy-ledger.md): one of energy_gain_rule_names(), by default the first, "total"
+  // (kDefaultEnergyGainRule). A choice of the bench, not physics: it moves no run, only the class
+  // and the gain metrics, and is named beside them (energy_gain_rule in every comparison and
+  // sweep record).
+  std::string energy_gain_rule = energy_gain_rule_names().front();
   // Which of rtol, atol, method, self_check the scene file gave in [run], their older spelling
   // (they are the reference's settings, [engines.analytic]); the reference notes them.
   std::vector<std::string> alias_keys{};

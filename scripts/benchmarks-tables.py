@@ -126,10 +126,13 @@ def render(text, name):
         i += 1
         if not m:
             continue
-        try:
-            end = lines.index(END, i)
-        except ValueError:
+        # The block ends at the first END; another marker before it means this one lost its end
+        # (taking the next block's would swallow that block).
+        end = next((j for j in range(i, len(lines)) if lines[j] == END or lines[j].startswith("<!-- generated from")), None)
+        if end is None:
             raise BadInput(f"{name}:{i}: no {END} after this marker")
+        if lines[end] != END:
+            raise BadInput(f"{name}:{i}: no {END} after this marker before the next one (line {end + 1})")
         page, heading = m.group(1), m.group(2)
         commits = page_commits(page)
         out.append("")
@@ -168,11 +171,23 @@ def main():
         print(f"benchmarks-tables: {name}: {blocks} generated table(s) match their pages")
         return 0
     if new != text:
-        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(a.file), prefix=".benchmarks-tables.")
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(new)
-        os.chmod(tmp, os.stat(a.file).st_mode & 0o777)
-        os.replace(tmp, a.file)
+        try:
+            fd, tmp = tempfile.mkstemp(dir=os.path.dirname(a.file), prefix=".benchmarks-tables.")
+        except OSError as e:
+            print(f"benchmarks-tables: {name}: {e}", file=sys.stderr)
+            return 2
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                f.write(new)
+            os.chmod(tmp, os.stat(a.file).st_mode & 0o777)
+            os.replace(tmp, a.file)
+        except BaseException as e:
+            # Nothing half-written: the file stays as it was and the temporary goes.
+            os.unlink(tmp)
+            if not isinstance(e, OSError):
+                raise
+            print(f"benchmarks-tables: {name}: {e}", file=sys.stderr)
+            return 2
     print(f"benchmarks-tables: {name}: {blocks} generated table(s) written")
     return 0
 

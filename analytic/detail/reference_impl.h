@@ -210,6 +210,9 @@ struct ReferenceModel::Impl {
   Vec3 gauss5(double a, double b, std::array<Vec3, 5>* nodes = nullptr);
   Vec3 friction_work(double a, double b, std::array<Vec3, 5>* nodes = nullptr);
   void accumulate_friction_work(double a, double b);
+  // The power at the end of the booked interval (from the check point or the event there): the
+  // fit accumulate_friction_work opened is complete.
+  void close_power_fit(const Vec3& p_end);
 
   double gap_acceleration(const StateVector& y, const ContactMode& m, int k);
 

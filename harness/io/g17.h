@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <system_error>
 
 namespace tippe {
@@ -28,7 +29,12 @@ inline const long double* powers_of_ten() {
 // rounded value (a ~ N 10^(X-16), 10^16 <= N < 10^17); false where the fast path cannot vouch
 // for the rounding (see g17).
 inline bool digits17(double a, std::uint64_t& n, int& x) {
-  // a = f 2^e2 with 0.5 <= f < 1, from the biased exponent (a is normal: subnormals have k > 27).
+  // The error bounds below need x87 extended precision (a 64-bit mantissa, as on x86-64): where
+  // long double is narrower (a plain double on ARM's and MSVC's ABIs) the products are no longer
+  // within 2^-64, and every number goes to to_chars.
+  if constexpr (std::numeric_limits<long double>::digits < 64) return false;
+  // a = f 2^e2 with 0.5 <= f < 1, from the biased exponent (a is normal: a subnormal, below
+  // 2.2e-308, has k > 54 and is handed to to_chars below).
   std::uint64_t bits;
   std::memcpy(&bits, &a, sizeof bits);
   const int e2 = static_cast<int>((bits >> 52) & 0x7ff) - 1022;

@@ -350,8 +350,12 @@ class Interpreter : public TomlReader {
       const auto* str = m->as_string();
       if (!str) fail("run.energy_gain_rule", "expected a string, got " + toml_value_text(*m));
       r.energy_gain_rule = str->get();
-      if (r.energy_gain_rule != "total" && r.energy_gain_rule != "ledger")
-        fail("run.energy_gain_rule", "must be \"total\" or \"ledger\", got \"" + r.energy_gain_rule + "\"");
+      const std::vector<std::string>& rules = energy_gain_rule_names();
+      if (std::find(rules.begin(), rules.end(), r.energy_gain_rule) == rules.end()) {
+        std::vector<std::string> quoted;
+        for (const std::string& n : rules) quoted.push_back("\"" + n + "\"");
+        fail("run.energy_gain_rule", "must be " + join(quoted, " or ") + ", got \"" + r.energy_gain_rule + "\"");
+      }
     }
     for (const char* k : {"rtol", "atol", "method", "self_check"})
       if (t.contains(k)) r.alias_keys.push_back(k);

@@ -101,10 +101,13 @@ double contact_energy_allowance(const Scene& scene) {
   return std::isfinite(a) && a > 0 ? a : 0.0;
 }
 
-const char* to_string(EnergyGainRule r) { return r == EnergyGainRule::Ledger ? "ledger" : "total"; }
+const char* to_string(EnergyGainRule r) { return energy_gain_rule_names().at(static_cast<size_t>(r)).c_str(); }
 
 EnergyGainRule energy_gain_rule(const Scene& scene) {
-  return scene.run.energy_gain_rule == "ledger" ? EnergyGainRule::Ledger : EnergyGainRule::Total;
+  // A name the scene reader did not check (a scene built in code) counts as the default.
+  const std::vector<std::string>& names = energy_gain_rule_names();
+  const auto it = std::find(names.begin(), names.end(), scene.run.energy_gain_rule);
+  return it == names.end() ? kDefaultEnergyGainRule : static_cast<EnergyGainRule>(it - names.begin());
 }
 
 std::vector<double> energy_counted(const Trajectory& tr, EnergyGainRule rule) {

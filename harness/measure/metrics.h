@@ -78,7 +78,8 @@ struct EnergyGains {
 // kept selectable (energy_gains' `rule`) and recorded beside every verdict.
 // The tolerance is the same under both (kEnergyGainTolerance * |E0| + the allowance, both stated
 // above): the ledger changes what is counted, not how much is tolerated.
-enum class EnergyGainRule { Ledger, Total };
+// In the order of energy_gain_rule_names() (analytic/scene.h), whose names to_string gives.
+enum class EnergyGainRule { Total, Ledger };
 const char* to_string(EnergyGainRule r);
 inline constexpr EnergyGainRule kDefaultEnergyGainRule = EnergyGainRule::Total;
 // The rule a scene asks for (run.energy_gain_rule, validated when the scene was read; its default

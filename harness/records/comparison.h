@@ -1,6 +1,7 @@
 // The comparison record (comparison.json): the reference, every engine's run and metrics, the reference's self-check.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -100,7 +101,12 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Metrics>> visit(R& m, V&
   v(Field("energy_final_ratio", "E_final / E0 of the engine"), m.energy_final_ratio);
   v(Field("energy_gain_events", "count"), m.energy_gain_events);
   v(Field("energy_max_gain", "/ E0"), m.energy_max_gain);
-  static const std::vector<std::string> rules = {"ledger", "total"};
+  // Sorted in the schema, which a new rule then extends in one place.
+  static const std::vector<std::string> rules = [] {
+    std::vector<std::string> r = energy_gain_rule_names();
+    std::sort(r.begin(), r.end());
+    return r;
+  }();
   v(Field("energy_gain_rule",
           "how energy_gain_events and energy_max_gain counted energy (harness/measure/metrics.h): ledger (energy "
           "created by the ledger's account) or total (E); absent in records written before it")
@@ -152,19 +158,20 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Metrics>> visit(R& m, V&
   v(Field("jellett_max_relative_drift", "relative"), m.jellett_max_relative_drift);
   // Timing is never bounded: it depends on the machine and its load (cost_ratio, a ratio of CPU
   // times on the same machine, is).
-  v(Field("wall_seconds", "s").not_bounded(), m.wall_seconds);
-  v(Field("cpu_seconds", "s").not_bounded(), m.cpu_seconds);
-  v(Field("real_time_factor", "simulated s per wall s").not_bounded(), m.real_time_factor);
+  static constexpr const char* kTiming =
+      "timing is never gated (it depends on the machine and its load); bound steps or cost_ratio";
+  v(Field("wall_seconds", "s").not_bounded(kTiming), m.wall_seconds);
+  v(Field("cpu_seconds", "s").not_bounded(kTiming), m.cpu_seconds);
+  v(Field("real_time_factor", "simulated s per wall s").not_bounded(kTiming), m.real_time_factor);
   v(Field("steps", "engine steps"), m.steps);
   v(Field("cost_ratio", "engine CPU / reference CPU"), m.cost_ratio);
   v(Field("compared_until", "s"), m.compared_until);
-  // The reference's, not the engine's: it marks a gate's rows instead.
   v(Field("reference_converged_until",
           "s: end of the reference's converged window when the metrics stop there; null: compared over the whole "
           "common grid")
         .since()
         .minimum(0)
-        .not_bounded(),
+        .not_bounded("the reference's, not the engine's: it marks a gate's rows instead"),
     m.reference_converged_until);
   v(Field("event_time_max_error", "largest |t_engine - t_reference| of matched events (0 when none is matched)")
         .since()
@@ -173,19 +180,26 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Metrics>> visit(R& m, V&
   // The event alignment: the counts on each side and of matches describe the sequences (missing
   // and extra judge them), the first wrong event is a text (require_no_wrong_event gates it), the
   // dwell is a setting of the bench.
+  static constexpr const char* kDescribes =
+      "a count that describes the aligned event sequences; bound events_missing or events_extra, which judge them";
+  static constexpr const char* kWrongEvent =
+      "require the aligned event sequences to agree with require_no_wrong_event = true";
   v(Field("events_reference",
           "canonical events of the reference in the compared window (absent in records older than the event "
           "alignment)")
         .since()
         .minimum(0)
-        .not_bounded(),
+        .not_bounded(kDescribes),
     m.events_reference);
-  v(Field("events_engine", "canonical events of the engine in the compared window").since().minimum(0).not_bounded(),
+  v(Field("events_engine", "canonical events of the engine in the compared window")
+        .since()
+        .minimum(0)
+        .not_bounded(kDescribes),
     m.events_engine);
   v(Field("events_matched", "aligned pairs of the same kind; events_matched + events_missing = events_reference")
         .since()
         .minimum(0)
-        .not_bounded(),
+        .not_bounded(kDescribes),
     m.events_matched);
   v(Field("events_missing", "reference events the engine lacks (a substitution counts one missing and one extra)")
         .since()
@@ -196,23 +210,29 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Metrics>> visit(R& m, V&
           "index in the aligned sequence of the first pair that is not a match; null when none")
         .since()
         .minimum(0)
-        .not_bounded(),
+        .not_bounded(kWrongEvent),
     m.first_wrong_event_index);
   v(Field("first_wrong_event",
           "\"reference: KIND at t=T, engine: KIND at t=T\" (a side without an event there reads \"none\"); null when "
           "the sequences agree")
         .since()
-        .empty_as_null(),
+        .empty_as_null()
+        .not_bounded("not a number: require the aligned event sequences to agree with require_no_wrong_event = true"),
     m.first_wrong_event);
   v(Field("events_not_compared", "events left out of the comparison, counted by name and side").since(),
     m.events_not_compared);
   v(Field("event_min_dwell", "surface phases shorter than this were merged on both sides (a setting of the bench)")
         .since()
         .minimum(0)
-        .not_bounded(),
+        .not_bounded("a setting of the bench, not a measurement"),
     m.event_min_dwell);
-  v(Field("event_alignment", "the first 20 aligned pairs (kMaxAlignedEventRowsKept)").since(), m.event_alignment);
-  v(Field("event_alignment_rows", "how many aligned pairs the whole alignment has").since().minimum(0).not_bounded(),
+  static const std::string alignment_doc =
+      "the first " + std::to_string(kMaxAlignedEventRowsKept) + " aligned pairs (kMaxAlignedEventRowsKept)";
+  v(Field("event_alignment", alignment_doc.c_str()).since(), m.event_alignment);
+  v(Field("event_alignment_rows", "how many aligned pairs the whole alignment has")
+        .since()
+        .minimum(0)
+        .not_bounded(kDescribes),
     m.event_alignment_rows);
 }
 

@@ -41,8 +41,14 @@ class Field {
   // The values a string (or each string of a list) may hold.
   Field one_of(const std::vector<std::string>& names) const { Field f = *this; f.choices_ = &names; return f; }
   // Left out of the metric table: the field is no number a bound may name (a timing, a count
-  // that describes rather than judges, a setting of the bench), the reason in `visit`.
-  Field not_bounded() const { Field f = *this; f.bounded_ = false; return f; }
+  // that describes rather than judges, a setting of the bench); `why` is what a bound naming it
+  // is told.
+  Field not_bounded(const char* why = "") const {
+    Field f = *this;
+    f.bounded_ = false;
+    f.not_bounded_why_ = why;
+    return f;
+  }
 
   const char* key() const { return key_; }
   const char* doc() const { return doc_; }
@@ -51,10 +57,12 @@ class Field {
   const std::optional<double>& min() const { return minimum_; }
   const std::vector<std::string>* choices() const { return choices_; }
   bool bounded() const { return bounded_; }
+  const char* not_bounded_why() const { return not_bounded_why_; }
 
  private:
   const char* key_;
   const char* doc_;
+  const char* not_bounded_why_ = "";
   bool since_ = false, empty_as_null_ = false, bounded_ = true;
   std::optional<double> minimum_;
   const std::vector<std::string>* choices_ = nullptr;

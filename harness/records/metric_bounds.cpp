@@ -4,7 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
-#include <type_traits>
 #include <utility>
 
 #include "harness/io/scene_io.h"
@@ -37,33 +36,37 @@ class MetricValue {
   std::string key_;
 };
 
-// The bounded numbers of Metrics' `visit`, keys and docs kept (string literals of `visit`).
-class BoundedMetrics {
+// What Metrics' `visit` says of one key: whether it is a field and, when no bound may name it, why.
+class FieldByKey {
  public:
+  explicit FieldByKey(std::string key) : key_(std::move(key)) {}
   template <class T>
   void operator()(const Field& f, const T&) {
-    using U = std::decay_t<T>;
-    if (f.bounded() && (std::is_same_v<U, double> || std::is_same_v<U, long long> ||
-                        std::is_same_v<U, std::optional<double>> || std::is_same_v<U, std::optional<long long>>))
-      table.push_back({f.key(),
-                       [key = std::string(f.key())](const Metrics& m) {
-                         MetricValue v(key);
-                         visit(m, v);
-                         return v.value;
-                       },
-                       f.doc()});
+    if (key_ == f.key()) {
+      found = true;
+      why = f.not_bounded_why();
+    }
   }
-  std::vector<GateMetric> table;
+  bool found = false;
+  std::string why;
+
+ private:
+  std::string key_;
 };
 
 }  // namespace
 
 const std::vector<GateMetric>& gate_metrics() {
   static const std::vector<GateMetric> table = [] {
-    BoundedMetrics b;
-    const Metrics m{};
-    visit(m, b);
-    return b.table;
+    std::vector<GateMetric> t;
+    for (const FieldInfo& f : field_list<Metrics>())
+      if (f.bounded)
+        t.push_back({f.key, [key = f.key](const Metrics& m) {
+                       MetricValue v(key);
+                       visit(m, v);
+                       return v.value;
+                     }});
+    return t;
   }();
   return table;
 }
@@ -75,16 +78,14 @@ const GateMetric* find_gate_metric(const std::string& name) {
 }
 
 std::string gate_metric_problem(const std::string& metric) {
-  if (metric == "wall_seconds" || metric == "cpu_seconds" || metric == "real_time_factor")
-    return "timing is never gated (it depends on the machine and its load); bound steps or cost_ratio";
-  if (metric == "first_wrong_event")
-    return "not a number: require the aligned event sequences to agree with require_no_wrong_event = true";
-  if (!find_gate_metric(metric)) {
-    std::vector<std::string> names;
-    for (const auto& g : gate_metrics()) names.emplace_back(g.name);
-    return "unknown metric (expected one of: " + join(names, ", ") + ")";
-  }
-  return {};
+  if (find_gate_metric(metric)) return {};
+  FieldByKey field(metric);
+  const Metrics m{};
+  visit(m, field);
+  if (field.found && !field.why.empty()) return field.why;
+  std::vector<std::string> names;
+  for (const auto& g : gate_metrics()) names.emplace_back(g.name);
+  return "unknown metric (expected one of: " + join(names, ", ") + ")";
 }
 
 std::string threshold_problem(const std::string& metric, double x) {

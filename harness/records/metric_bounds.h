@@ -13,13 +13,12 @@ namespace tippe {
 // ---- metrics a gate may bound --------------------------------------------------------------
 
 // A numeric field of Metrics a threshold can name: every number of Metrics' `visit` but those it
-// marks not_bounded (comparison.h says why: timing, which depends on the machine and its load;
-// counts that describe the event sequences; settings of the bench). cost_ratio is a ratio of CPU
-// times on the same machine, so it stays.
+// marks not_bounded (with the reason: timing, which depends on the machine and its load; counts
+// that describe the event sequences; settings of the bench). cost_ratio is a ratio of CPU times
+// on the same machine, so it stays. Its unit and meaning are the field's doc (field_list).
 struct GateMetric {
-  const char* name;
+  std::string name;
   std::function<std::optional<double>(const Metrics&)> get;  // nullopt: absent in this comparison
-  const char* unit;                                           // unit and meaning (the field's doc)
 };
 // Every gate metric, in the order of Metrics' `visit` (the order tables and results list them).
 const std::vector<GateMetric>& gate_metrics();
@@ -33,7 +32,8 @@ struct Threshold {
 
 // ---- bounds as text ---------------------------------------------------------------------------
 
-// "" when `metric` may be gated (a gate metric, not a timing), else the reason.
+// "" when `metric` may be gated (a gate metric), else the reason: for a field of Metrics its
+// `visit`'s not_bounded reason.
 std::string gate_metric_problem(const std::string& metric);
 // "" when `x` is a usable threshold of `metric` (>= 0: |value| is compared), else the reason.
 std::string threshold_problem(const std::string& metric, double x);

@@ -32,6 +32,18 @@ namespace {
 using nlohmann::json;
 
 
+// The ledger's terms a simulator may not give, as ledger_not_available names them, and where a
+// sample holds each.
+struct SampleLedgerTerm {
+  const char* name;
+  double Observation::*value;
+};
+constexpr SampleLedgerTerm kSampleLedgerTerms[] = {{"normal_work", &Observation::normal_work},
+                                                   {"friction_work", &Observation::friction_work},
+                                                   {"drilling_work", &Observation::drilling_work},
+                                                   {"impact_energy", &Observation::impact_energy},
+                                                   {"elastic_energy", &Observation::elastic_energy}};
+
 
 
 
@@ -114,11 +126,8 @@ void SampleSummary::fill(RunRecord& r) const {
   r.numerical_energy_max = numerical_max_;
   r.numerical_energy_final = last_.numerical_energy;
   r.ledger_not_available.clear();
-  const std::pair<const char*, double> terms[] = {{"normal_work", last_.normal_work},   {"friction_work", last_.friction_work},
-                                                  {"drilling_work", last_.drilling_work}, {"impact_energy", last_.impact_energy},
-                                                  {"elastic_energy", last_.elastic_energy}};
-  for (const auto& [name, v] : terms)
-    if (std::isnan(v)) r.ledger_not_available.push_back(name);
+  for (const SampleLedgerTerm& t : kSampleLedgerTerms)
+    if (std::isnan(last_.*t.value)) r.ledger_not_available.push_back(t.name);
   if (drift_ball_ || drift_stem_)
     r.jellett_max_relative_drift = std::max(drift_ball_.value_or(0.0), drift_stem_.value_or(0.0));
   else
@@ -163,8 +172,11 @@ const std::vector<std::string>& event_names() {
 }
 
 const std::vector<std::string>& ledger_term_names() {
-  static const std::vector<std::string> names = {"normal_work", "friction_work", "drilling_work", "impact_energy",
-                                                 "elastic_energy"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const SampleLedgerTerm& t : kSampleLedgerTerms) n.emplace_back(t.name);
+    return n;
+  }();
   return names;
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "harness/report/ledger_chart.h"
+#include "harness/report/ledger_terms.h"
 #include "harness/report/report_text.h"
 
 namespace tippe {
@@ -16,35 +17,13 @@ namespace {
 using nlohmann::json;
 using namespace report_text;
 
-// The ledger's terms in a run summary, in table order, with how a sentence names them.
-struct Term {
-  const char* key;
-  const char* header;
-  const char* name;
-};
-const std::vector<Term>& terms() {
-  static const std::vector<Term> t = {{"normal_work", "normal work", "normal-force work"},
-                                      {"friction_work", "friction work", "friction work"},
-                                      {"drilling_work", "drilling work", "drilling-torque work"},
-                                      {"impact_energy", "impacts (removed)", "impacts"},
-                                      {"numerical_energy_final", "numerical (end)", "numerical"}};
-  return t;
-}
-
-bool has_ledger(const json& s) { return has_number(s, "numerical_energy_final"); }
-
-double scale_of(const json& s) {
-  const double e0 = num(s, "energy_initial");
-  return std::isfinite(e0) && e0 != 0 ? std::abs(e0) : 1.0;
-}
-
 std::string rel(const json& s, const char* key) {
-  return has_number(s, key) ? fmt(num(s, key) / scale_of(s), "%.3g") : std::string("n/a");
+  return has_number(s, key) ? fmt(num(s, key) / ledger_scale(s), "%.3g") : std::string("n/a");
 }
 
 // The share of the run's energy loss E0 - E_final each term explains (impacts remove, the work
-// terms and the numerical remainder add: each enters with the sign that makes the shares sum to
-// 100 % over the available terms).
+// terms and the numerical remainder add: each enters with the opposite of its sign in
+// E_final - E0, which makes the shares sum to 100 % over the available terms).
 struct Share {
   std::string name;
   double percent;
@@ -53,10 +32,9 @@ std::vector<Share> shares(const json& s) {
   const double loss = num(s, "energy_initial") - num(s, "energy_final");
   std::vector<Share> out;
   if (!(std::isfinite(loss) && loss != 0)) return out;
-  for (const Term& t : terms()) {
+  for (const LedgerTerm& t : ledger_terms()) {
     if (!has_number(s, t.key)) continue;
-    const double v = num(s, t.key);
-    const double removed = std::string(t.key) == "impact_energy" ? v : -v;
+    const double removed = -t.sign * num(s, t.key);
     out.push_back({t.name, 100.0 * removed / loss});
   }
   return out;
@@ -89,13 +67,13 @@ std::string ledger_cause_sentence(const json& c, const json& e) {
   const bool flip = s_end.contains("ledger_at_inversion") && s_end.at("ledger_at_inversion").is_object();
   const json s = flip ? at_inversion(s_end) : s_end;
   const json& ref = c.at("reference").at("summary");
-  const double loss = (num(s, "energy_initial") - num(s, "energy_final")) / scale_of(s);
+  const double loss = (num(s, "energy_initial") - num(s, "energy_final")) / ledger_scale(s);
   const std::string t_end = fmt(num(s, "final_time"), "%.6g");
   std::string out = "by t = " + t_end + (flip ? " (its inversion)" : "") + " its energy " +
                     (loss >= 0 ? "fell by " + fmt(loss, "%.3g") : "rose by " + fmt(-loss, "%.3g")) + " E0";
   if (has_ledger(ref))
     out += " (the reference's by its end, t = " + fmt(num(ref, "final_time"), "%.6g") + ": " +
-           fmt((num(ref, "energy_initial") - num(ref, "energy_final")) / scale_of(ref), "%.3g") + " E0)";
+           fmt((num(ref, "energy_initial") - num(ref, "energy_final")) / ledger_scale(ref), "%.3g") + " E0)";
   const std::vector<Share> sh = shares(s);
   if (sh.empty()) return out + ".";
   out += "; of that change " + share_text(sh);
@@ -131,16 +109,21 @@ void add_energy_ledger(Document& d, const json& c, bool chart) {
          "simulator cannot give the term (counted as 0 in the remainder).",
          "note");
   DocTable t;
-  t.header = {"run", "E final - E0", "normal work", "friction work", "drilling work", "impacts (removed)",
-              "elastic max", "numerical (end)", "numerical max |N|"};
+  // The columns: the terms, with the largest elastic energy (stored by a soft contact, part of the
+  // normal work) before the numerical remainder, the last term, and the remainder's largest |N| after it.
+  std::vector<std::pair<const char*, const char*>> columns;  // summary key, header
+  for (const LedgerTerm& term : ledger_terms()) columns.push_back({term.key, term.header});
+  columns.insert(columns.end() - 1, {"elastic_energy_max", "elastic max"});
+  columns.push_back({"numerical_energy_max", "numerical max |N|"});
+  t.header = {"run", "E final - E0"};
+  for (const auto& col : columns) t.header.push_back(col.second);
   t.row_headers = true;
   t.css = "detail";
   auto row = [&](const std::string& name, const json& s) {
-    const double de = (num(s, "energy_final") - num(s, "energy_initial")) / scale_of(s);
-    t.rows.push_back({DocCell(name), DocCell(fmt(de, "%.3g")), DocCell(rel(s, "normal_work")),
-                      DocCell(rel(s, "friction_work")), DocCell(rel(s, "drilling_work")), DocCell(rel(s, "impact_energy")),
-                      DocCell(rel(s, "elastic_energy_max")), DocCell(rel(s, "numerical_energy_final")),
-                      DocCell(rel(s, "numerical_energy_max"))});
+    const double de = (num(s, "energy_final") - num(s, "energy_initial")) / ledger_scale(s);
+    std::vector<DocCell> cells = {DocCell(name), DocCell(fmt(de, "%.3g"))};
+    for (const auto& col : columns) cells.push_back(DocCell(rel(s, col.first)));
+    t.rows.push_back(cells);
   };
   row("reference", ref);
   for (const json& e : c.at("engines")) row(str(e, "engine"), e.at("summary"));

@@ -83,7 +83,7 @@ Cell event_error_cell(const json& comparison, const json& metrics, const std::st
   const double rel_err = num(metrics, (key + "_time_rel_error").c_str());
   std::string text = fmt(abs_err, "%+.3g");
   if (std::isfinite(rel_err)) text += " (" + fmt(100 * rel_err, "%+.2g") + " %)";
-  return {text, grade_against(comparison, key + "_time_rel_error", rel_err, 0.01, 0.10)};
+  return {text, grade_against(comparison, key + "_time_rel_error", rel_err, kEventTimeGreenBand, kEventTimeAmberBand)};
 }
 
 std::string cpu_text(const json& summary, bool cached) {
@@ -279,8 +279,10 @@ std::vector<std::string> report_findings(const json& c) {
                       "); the reference has one at t = " + fmt(num(ref, time_key.c_str()), "%.6g"));
     }
     const long long gains = m.value("energy_gain_events", 0LL);
+    const std::string ledger = to_string(EnergyGainRule::Ledger);
     if (gains > 0)
-      out.push_back(engine + ": energy " + (str(m, "energy_gain_rule") == "ledger" ? "created (energy_gain_rule = ledger) " : "") +
+      out.push_back(engine + ": energy " +
+                    (str(m, "energy_gain_rule") == ledger ? "created (energy_gain_rule = " + ledger + ") " : std::string()) +
                     "rose above its lowest earlier value " + std::to_string(gains) + " time" +
                     (gains == 1 ? "" : "s") + " by more than " + fmt(kEnergyGainTolerance, "%g") +
                     " E0 and the energy of 1e-4 R of contact depth (largest net rise " + fmt(num(m, "energy_max_gain"), "%.3g") +

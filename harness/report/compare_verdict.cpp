@@ -95,7 +95,7 @@ std::vector<std::string> verdict_sentences(const json& c) {
     // Where the engine deviates (another regime, an early end, or an inversion time off by more
     // than the report's 1 % green band), the verdict names where its energy went.
     const double rel = num(m, "inversion_time_rel_error");
-    const bool deviates = !ok || ref_inverts != inverts || (std::isfinite(rel) && std::abs(rel) > 0.01);
+    const bool deviates = !ok || ref_inverts != inverts || (std::isfinite(rel) && std::abs(rel) > kEventTimeGreenBand);
     if (deviates)
       if (const std::string cause = ledger_cause_sentence(c, e); !cause.empty()) t += " Energy: " + cause;
     out.push_back(t);

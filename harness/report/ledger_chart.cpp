@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "harness/io/text.h"
+#include "harness/report/ledger_terms.h"
 #include "harness/report/report_text.h"
 
 namespace tippe {
@@ -15,54 +17,18 @@ namespace {
 using nlohmann::json;
 using namespace report_text;
 
-// The terms in stacking order, with the sign each enters E_final - E0 with, and a colour from
-// the Okabe-Ito palette (told apart with colour-blindness; the legend names them as well).
-struct Term {
-  const char* key;
-  const char* label;
-  double sign;
-  const char* colour;
-};
-const std::vector<Term>& terms() {
-  static const std::vector<Term> t = {{"normal_work", "normal work", 1.0, "#E69F00"},
-                                      {"friction_work", "friction work", 1.0, "#0072B2"},
-                                      {"drilling_work", "drilling work", 1.0, "#009E73"},
-                                      {"impact_energy", "impacts (removed)", -1.0, "#CC79A7"},
-                                      {"numerical_energy_final", "numerical", 1.0, "#D55E00"}};
-  return t;
-}
-
-std::string xml_escaped(const std::string& s) {
-  std::string out;
-  for (const char ch : s) {
-    switch (ch) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default:
-        // Control characters have no place in a name drawn as text.
-        out += static_cast<unsigned char>(ch) < 0x20 ? '_' : ch;
-    }
-  }
-  return out;
-}
-
 struct Bar {
   std::string name;
-  std::vector<std::pair<const Term*, double>> parts;  // value / |E0|, signed as in E_final - E0
-  double total = std::nan("");                          // (E_final - E0) / |E0|
+  std::vector<std::pair<const LedgerTerm*, double>> parts;  // value / |E0|, signed as in E_final - E0
+  double total = std::nan("");                               // (E_final - E0) / |E0|
 };
-
-bool has_ledger(const json& s) { return has_number(s, "numerical_energy_final"); }
 
 Bar bar_of(const std::string& name, const json& s) {
   Bar b;
   b.name = name;
   const double e0 = num(s, "energy_initial");
-  const double scale = std::isfinite(e0) && e0 != 0 ? std::abs(e0) : 1.0;
-  for (const Term& t : terms())
+  const double scale = ledger_scale(s);
+  for (const LedgerTerm& t : ledger_terms())
     if (has_number(s, t.key)) b.parts.push_back({&t, t.sign * num(s, t.key) / scale});
   b.total = (num(s, "energy_final") - e0) / scale;
   return b;
@@ -128,7 +94,7 @@ std::string ledger_chart_svg(const json& c) {
     const Bar& b = bars[i];
     const int y = top + row * static_cast<int>(i) + (row - bar_h) / 2;
     s += "<text x=\"" + std::to_string(left - 8) + "\" y=\"" + std::to_string(y + bar_h - 4) +
-         "\" text-anchor=\"end\">" + xml_escaped(b.name) + "</text>\n";
+         "\" text-anchor=\"end\">" + markup_escape(b.name) + "</text>\n";
     double neg = 0.0, pos = 0.0;
     for (const auto& [t, v] : b.parts) {
       if (v == 0 || !std::isfinite(v)) continue;
@@ -136,7 +102,7 @@ std::string ledger_chart_svg(const json& c) {
       (v < 0 ? neg : pos) += v;
       s += "<rect class=\"term\" data-term=\"" + std::string(t->key) + "\" data-value=\"" + fmt(v, "%.6g") + "\" x=\"" +
            num_text(x_of(from)) + "\" y=\"" + std::to_string(y) + "\" width=\"" + num_text(x_of(to) - x_of(from)) +
-           "\" height=\"" + std::to_string(bar_h) + "\" fill=\"" + t->colour + "\"><title>" + xml_escaped(b.name) + ": " +
+           "\" height=\"" + std::to_string(bar_h) + "\" fill=\"" + t->colour + "\"><title>" + markup_escape(b.name) + ": " +
            t->label + " " + fmt(v, "%.3g") + " E0</title></rect>\n";
     }
     if (std::isfinite(b.total)) {
@@ -149,7 +115,7 @@ std::string ledger_chart_svg(const json& c) {
   // Legend.
   int lx = left;
   const int ly = plot_bottom + 40;
-  for (const Term& t : terms()) {
+  for (const LedgerTerm& t : ledger_terms()) {
     s += "<rect x=\"" + std::to_string(lx) + "\" y=\"" + std::to_string(ly) + "\" width=\"14\" height=\"14\" fill=\"" +
          t.colour + "\"/><text x=\"" + std::to_string(lx + 20) + "\" y=\"" + std::to_string(ly + 12) + "\">" + t.label +
          "</text>\n";

@@ -9,6 +9,12 @@
 
 namespace tippe::report_text {
 
+// The report's bands for an event time's relative error (inversion, stem contact) when the
+// record states none: green below 1 %, amber below 10 %. The verdict names where the energy went
+// for an engine outside the green band.
+inline constexpr double kEventTimeGreenBand = 0.01;
+inline constexpr double kEventTimeAmberBand = 0.10;
+
 // A number with a printf spec; "-" for NaN and infinities.
 inline std::string fmt(double v, const char* spec = "%.4g") {
   if (!std::isfinite(v)) return "-";

@@ -37,20 +37,31 @@ std::string resolve_file(const Scene& s, const EngineFileSetting& f, SettingValu
   return bytes;
 }
 
+// Calls fn(setting, value) for every engine file setting (engine_file_settings) the scene gives,
+// in the registry's order; S is Scene or const Scene.
+template <class S, class F>
+void for_each_engine_file(S& s, F&& fn) {
+  for (const EngineFileSetting& f : engine_file_settings()) {
+    const auto engine = s.engines.find(f.engine);
+    if (engine == s.engines.end()) continue;
+    const auto it = engine->second.find(f.key);
+    if (it != engine->second.end()) fn(f, it->second);
+  }
+}
+
 }  // namespace
 
 Scene resolve_scene(SceneFile file) {
   Scene& s = file.scene;
   // An engine's files first: its checks (MuJoCo compiling a user's model) read the resolved path.
   std::vector<std::pair<std::string, std::string>> inputs;
-  for (const EngineFileSetting& f : engine_file_settings()) {
-    auto engine = s.engines.find(f.engine);
-    if (engine == s.engines.end()) continue;
-    auto it = engine->second.find(f.key);
-    if (it == engine->second.end()) continue;
-    std::string bytes = resolve_file(s, f, it->second);
-    inputs.emplace_back("engines." + f.engine + "." + f.key, std::move(bytes));
-  }
+  for_each_engine_file(s, [&](const EngineFileSetting& f, SettingValue& value) {
+    inputs.emplace_back("engines." + f.engine + "." + f.key, resolve_file(s, f, value));
+  });
+  // The file layer hashed the scene's bytes and overrides (parse_scene_file), all there is to a
+  // scene without engine files; it reads no engine's file, so the hash that covers them is made
+  // here, over the same text and overrides (scene_content_hash with no inputs is the file
+  // layer's: the published records' hashes stay as they were).
   if (!inputs.empty()) s.content_hash = scene_content_hash(file.text, file.overrides, inputs);
   try {
     validate_engine_settings(s);
@@ -85,13 +96,9 @@ Scene parse_scene_text(const std::string& text, const std::string& file_label,
 std::vector<std::filesystem::path> scene_input_files(const Scene& scene) {
   std::vector<std::filesystem::path> files;
   if (!scene.source_file.empty()) files.emplace_back(scene.source_file);
-  for (const EngineFileSetting& f : engine_file_settings()) {
-    const auto engine = scene.engines.find(f.engine);
-    if (engine == scene.engines.end()) continue;
-    const auto it = engine->second.find(f.key);
-    if (it != engine->second.end())
-      if (const auto* path = std::get_if<std::string>(&it->second)) files.emplace_back(*path);
-  }
+  for_each_engine_file(scene, [&](const EngineFileSetting&, const SettingValue& value) {
+    if (const auto* path = std::get_if<std::string>(&value)) files.emplace_back(*path);
+  });
   return files;
 }
 

@@ -76,5 +76,14 @@ with tempfile.TemporaryDirectory() as d:
     expect("... copies that section's table", first_row in got and got.count("<!-- generated from") == blocks + 1)
     r = check_with(text + '\n<!-- generated from reports/README.md, "Tippe top: engines against the analytic reference" -->\n')
     expect("refuses a block without its end", r.returncode == 2 and "no <!-- end generated -->" in r.stderr, r.stderr.strip())
+    # A marker whose end is missing before the next block: refused, not run to the next block's end.
+    lost = text.replace("<!-- end generated -->", "", 1)
+    r = check_with(lost)
+    expect("refuses a block whose end comes after the next marker",
+           r.returncode == 2 and "before the next one" in r.stderr, r.stderr.strip())
+    r = run("--file", copy)
+    with open(copy, encoding="utf-8") as f:
+        expect("... and writes nothing", r.returncode == 2 and f.read() == lost)
+    expect("... nor leaves a temporary file", not any(n.startswith(".benchmarks-tables.") for n in os.listdir(d)))
 
 sys.exit(1 if failures else 0)

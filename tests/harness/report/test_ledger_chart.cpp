@@ -123,6 +123,17 @@ TEST(LedgerChart, NamesFromTheRecordAreEscaped) {
   EXPECT_EQ(svg.find("<script"), std::string::npos);
 }
 
+// The SVG declares no encoding, so XML reads it as UTF-8: a name with a byte that is not UTF-8,
+// or a control character XML 1.0 does not allow, must not make the file unreadable.
+TEST(LedgerChart, NamesFromTheRecordBecomeValidXmlText) {
+  json c = synthetic();
+  c["engines"][0]["engine"] = std::string("so\xff\x01" "ft");
+  const std::string svg = ledger_chart_svg(c);
+  EXPECT_EQ(svg.find('\xff'), std::string::npos);
+  EXPECT_EQ(svg.find('\x01'), std::string::npos);
+  EXPECT_NE(svg.find(">so"), std::string::npos);
+}
+
 TEST(LedgerChart, NothingWithoutALedger) {
   json c = synthetic();
   c["reference"]["summary"].erase("numerical_energy_final");
