@@ -28,7 +28,6 @@ namespace fs = std::filesystem;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-bool usable(double v) { return std::isfinite(v) && v > 0; }
 
 }  // namespace
 
@@ -38,7 +37,7 @@ ConvergenceFit convergence_order(const std::vector<double>& h, const std::vector
   ConvergenceFit fit;
   std::vector<size_t> pts;
   for (size_t i = 0; i < h.size() && i < error.size(); ++i)
-    if (usable(h[i]) && usable(error[i])) pts.push_back(i);
+    if (sweep_report_detail::usable(h[i]) && sweep_report_detail::usable(error[i])) pts.push_back(i);
   std::stable_sort(pts.begin(), pts.end(), [&](size_t a, size_t b) { return h[a] < h[b]; });
   // Equal steps say nothing about a slope: the first of each is kept.
   pts.erase(std::unique(pts.begin(), pts.end(), [&](size_t a, size_t b) { return h[a] == h[b]; }), pts.end());

@@ -17,7 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool usable(double v) { return std::isfinite(v) && v > 0; }
 
 struct MetricInfo {
   const char* key;
@@ -41,7 +40,7 @@ const std::vector<MetricInfo>& metric_infos() {
 }
 
 // One series of a chart: a setup's points as (x, y), in ladder order.
-struct Series {
+struct ChartSeries {
   std::string title, engine;
   int variant = 0;  // how many earlier setups of the same engine: picks dash and point type
   std::vector<std::pair<double, double>> xy;
@@ -50,12 +49,12 @@ struct Chart {
   std::string file, title, caption, ylabel;
   bool logy = true;
   std::optional<double> hline;  // regime charts: the end of the run
-  std::vector<Series> series;
+  std::vector<ChartSeries> series;
 };
 
 // One series per line (a setup, or a grid value of it), with the lines' points beside it.
-std::vector<Series> setup_series(const SceneGroup& s, std::vector<std::vector<SweepRecord>>& points) {
-  std::vector<Series> out;
+std::vector<ChartSeries> setup_series(const SceneGroup& s, std::vector<std::vector<SweepRecord>>& points) {
+  std::vector<ChartSeries> out;
   std::map<std::string, int> per_engine;
   points.clear();
   for (const SetupGroup& u : s.setups)
@@ -98,7 +97,7 @@ std::vector<Chart> make_charts(const SceneGroup& s, size_t scene) {
     c.hline = s.duration;
     std::vector<std::vector<SweepRecord>> points;
     c.series = setup_series(s, points);
-    Series early{"ended early", "", 0, {}};
+    ChartSeries early{"ended early", "", 0, {}};
     for (size_t i = 0; i < points.size(); ++i)
       for (const SweepRecord& r : points[i]) {
         if (!usable(r.cpu_seconds)) continue;
@@ -151,8 +150,8 @@ std::vector<std::string> render_sweep_charts(const fs::path& dir, const std::vec
   std::vector<GpFigure> figures;
   std::vector<std::string> planned;
   for (const Chart& c : charts) {
-    std::vector<const Series*> nonempty;
-    for (const Series& s : c.series)
+    std::vector<const ChartSeries*> nonempty;
+    for (const ChartSeries& s : c.series)
       if (!s.xy.empty()) nonempty.push_back(&s);
     if (nonempty.empty()) continue;
     const std::string dat = "sweep-" + c.file.substr(0, c.file.size() - 4) + ".dat";
@@ -167,7 +166,7 @@ std::vector<std::string> render_sweep_charts(const fs::path& dir, const std::vec
     if (!c.logy) f.yrange = std::make_pair(0.0, 1.08 * c.hline.value_or(1.0));
     f.ymark = c.hline;
     for (size_t i = 0; i < nonempty.size(); ++i) {
-      const Series& s = *nonempty[i];
+      const ChartSeries& s = *nonempty[i];
       // The title is data (`title columnheader(1)`): no name reaches the script.
       d += gp_column_header(s.title) + "\n";
       for (const auto& [x, y] : s.xy) d += fmt("%.17g", x) + " " + fmt("%.17g", y) + "\n";

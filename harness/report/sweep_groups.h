@@ -17,6 +17,8 @@ inline std::string fmt(const char* f, double v) {
   std::snprintf(buf, sizeof buf, f, v);
   return buf;
 }
+// A value a log axis can show: finite and positive.
+inline bool usable(double v) { return std::isfinite(v) && v > 0; }
 inline std::string last_part(const std::string& key) { return key.substr(key.rfind('.') + 1); }
 inline std::string g3(double v) { return std::isfinite(v) ? fmt("%.3g", v) : "-"; }
 inline std::string pct(double v) { return std::isfinite(v) ? fmt("%.3g", 100 * v) + " %" : "-"; }
