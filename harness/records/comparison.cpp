@@ -64,30 +64,10 @@ std::string physics_hash(const json& scene_json) {
 std::string physics_hash(const Scene& scene) { return physics_hash(scene_to_json(scene)); }
 
 
-json to_json(const SelfCheck& s) {
-  return json{{"method", s.method},
-              {"rtol", s.rtol},
-              {"atol", s.atol},
-              {"converged_until", number(s.converged_until)},
-              {"reason", s.reason},
-              {"cpu_seconds", number(s.cpu_seconds)}};
-}
+json to_json(const SelfCheck& s) { return JsonWriter::write(s); }
 
 SelfCheck self_check_from_json(const json& j) {
-  SelfCheck s;
-  s.method = j.at("method").get<std::string>();
-  s.rtol = j.at("rtol").get<double>();
-  s.atol = j.value("atol", 0.0);
-  const json& cu = j.at("converged_until");
-  if (!cu.is_null()) {
-    const double t = cu.get<double>();
-    if (!(std::isfinite(t) && t >= 0))
-      throw std::invalid_argument("reference.self_check.converged_until: " + cu.dump() + " is not a time >= 0 or null");
-    s.converged_until = t;
-  }
-  s.reason = j.at("reason").get<std::string>();
-  s.cpu_seconds = get_number(j, "cpu_seconds");
-  return s;
+  return JsonReader::read<SelfCheck>(j, "reference.self_check.", /*checked=*/true);
 }
 
 // ---- records --------------------------------------------------------------------------------

@@ -246,10 +246,22 @@ struct SelfCheck {
   std::string reason;                     // where and how they part ("" when they do not)
   double cpu_seconds = 0;                 // the second run's
 };
-// {"method", "rtol", "atol", "converged_until" (number or null), "reason", "cpu_seconds"}
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, SelfCheck>> visit(R& s, V& v) {
+  v(Field("method", "the second run's integration method"), s.method);
+  v(Field("rtol", "the second run's relative tolerance"), s.rtol);
+  // Records written before the absolute tolerance was a setting of the check: 0.
+  v(Field("atol", "the second run's absolute tolerance").since(), s.atol);
+  v(Field("converged_until", "s: where the two runs part; null: they agree over the whole run").minimum(0),
+    s.converged_until);
+  v(Field("reason", "where and how the two runs part (empty when they do not)"), s.reason);
+  v(Field("cpu_seconds", "s: the second run's"), s.cpu_seconds);
+}
+// The fields of its `visit`, as JSON.
 nlohmann::json to_json(const SelfCheck& s);
-// Throws nlohmann::json::exception for a missing or mistyped field, std::invalid_argument for a
-// converged_until that is neither null nor a finite number >= 0.
+// Throws nlohmann::json::exception for a missing or mistyped field, std::invalid_argument
+// ("reference.self_check.KEY: reason") for a converged_until that is neither null nor a finite
+// number >= 0.
 SelfCheck self_check_from_json(const nlohmann::json& j);
 
 struct EngineResult {

@@ -138,6 +138,9 @@ class JsonWriter {
 //  - A field `since` a format change, absent (or null): the field keeps its default. Present, the
 //    same reading, except that an optional count, a bounded number, a string and a list of parts
 //    are checked by the reader itself.
+//  - Every field, `since` or not, is held to its Field's rules: a string (or each string of a
+//    list) among its choices, a number or count at or above its minimum (null passes: the
+//    schema allows it).
 //  - What the reader checks itself (a string among its choices, a bound, a count, a list) fails
 //    with "WHERE.KEY: reason" (WHERE: the prefix, e.g. "metrics." or "events[]."): as
 //    nlohmann::json::other_error, or as std::invalid_argument for a `checked` reader (the
@@ -164,17 +167,24 @@ class JsonReader {
     v = j_.at(f.key()).get<std::string>();
     if (f.choices()) check_choice(f, v);
   }
+  // A number: null reads as NaN (not a number, as written); a number present is checked
+  // against the field's minimum.
   void operator()(const Field& f, double& v) {
     if (f.is_since() && !j_.contains(f.key())) return;
     v = get_number(j_, f.key());
+    if (f.min() && !std::isnan(v) && !(std::isfinite(v) && v >= *f.min()))
+      fail(f, j_.at(f.key()).dump() + " is not a number >= " + bound(*f.min()) + " or null");
   }
   void operator()(const Field& f, std::optional<double>& v) {
     if (f.is_since() && absent(f)) return;
     v = get_optional(j_, f.key());
-    if (v && f.is_since() && f.min() && !(std::isfinite(*v) && *v >= *f.min()))
+    if (v && f.min() && !(std::isfinite(*v) && *v >= *f.min()))
       fail(f, j_.at(f.key()).dump() + " is not a number >= " + bound(*f.min()) + " or null");
   }
-  void operator()(const Field& f, long long& v) { v = json_integer(j_, f.key()); }
+  void operator()(const Field& f, long long& v) {
+    v = json_integer(j_, f.key());
+    if (f.min() && static_cast<double>(v) < *f.min()) fail(f, j_.at(f.key()).dump() + " is not a count >= " + bound(*f.min()));
+  }
   void operator()(const Field& f, std::optional<long long>& v) {
     if (f.is_since()) {
       if (absent(f)) return;
@@ -184,8 +194,13 @@ class JsonReader {
       v = x.get<long long>();
       return;
     }
-    if (j_.at(f.key()).is_null()) v = std::nullopt;
-    else v = json_integer(j_, f.key());
+    if (j_.at(f.key()).is_null()) {
+      v = std::nullopt;
+      return;
+    }
+    v = json_integer(j_, f.key());
+    if (f.min() && static_cast<double>(*v) < *f.min())
+      fail(f, j_.at(f.key()).dump() + " is not a count >= " + bound(*f.min()) + " or null");
   }
   void operator()(const Field& f, bool& v) {
     if (f.is_since() && !j_.contains(f.key())) return;
@@ -194,6 +209,8 @@ class JsonReader {
   void operator()(const Field& f, std::vector<std::string>& v) {
     if (f.is_since() && !j_.contains(f.key())) return;
     v = j_.at(f.key()).get<std::vector<std::string>>();
+    if (f.choices())
+      for (const std::string& x : v) check_choice(f, x);
   }
   void operator()(const Field& f, nlohmann::json& v) {
     if (f.is_since() && !j_.contains(f.key())) return;
@@ -360,6 +377,9 @@ class SchemaBuilder {
 struct FieldInfo {
   std::string key, doc;
   bool number = false, bounded = false;
+  std::optional<double> min;  // the Field's minimum
+  bool choices = false;       // the Field's values are a list of names (one_of)
+  bool list = false;          // a list of strings
 };
 class FieldNames {
  public:
@@ -369,7 +389,8 @@ class FieldNames {
     using U = std::decay_t<T>;
     constexpr bool numeric = std::is_same_v<U, double> || std::is_same_v<U, long long> ||
                              std::is_same_v<U, std::optional<double>> || std::is_same_v<U, std::optional<long long>>;
-    fields.push_back({f.key(), f.doc(), numeric, numeric && f.bounded()});
+    fields.push_back({f.key(), f.doc(), numeric, numeric && f.bounded(), f.min(), f.choices() != nullptr,
+                      std::is_same_v<U, std::vector<std::string>>});
   }
 };
 template <class T>

@@ -16,7 +16,8 @@ namespace {
 using ordered = nlohmann::ordered_json;
 
 // What no field list gives: the schema's identity, the "format" each record names, the parts of
-// a comparison that are its frame rather than fields (reference, engines, the engine versions).
+// a comparison that are its frame rather than fields (reference, engines, the engine versions);
+// the reference's self-check is its `visit`'s.
 constexpr const char* kRunSummaryFrame = R"json({
   "$schema": "https://json-schema.org/draft/2020-12/schema",
   "$id": "run-summary.schema.json",
@@ -53,19 +54,7 @@ constexpr const char* kComparisonFrame = R"json({
       "type": "object",
       "properties": {
         "cached": {"type": "boolean"},
-        "summary": {"$ref": "run-summary.schema.json#/$defs/summary"},
-        "self_check": {
-          "type": "object",
-          "properties": {
-            "method": {"type": "string"},
-            "rtol": {"type": "number"},
-            "atol": {"type": "number"},
-            "cached": {"type": "boolean"},
-            "converged_until": {"type": ["number", "null"]},
-            "cpu_seconds": {"type": ["number", "null"]},
-            "reason": {"type": "string"}
-          }
-        }
+        "summary": {"$ref": "run-summary.schema.json#/$defs/summary"}
       },
       "required": ["cached", "summary"]
     },
@@ -110,6 +99,14 @@ ordered comparison_schema() {
   m["description"] =
       "An engine's run against the reference (README, 'Metrics'): errors in SI units (m, rad, J/E0), times in s";
   s["$defs"]["metrics"] = m;
+  // The reference's self-check: its fields, and whether it came from the cache (the
+  // comparison's, written beside them).
+  SchemaBuilder check;
+  const SelfCheck self_check{};
+  visit(self_check, check);
+  check.properties["cached"] = {{"type", "boolean"}, {"description", "the self-check came from the reference cache"}};
+  check.required.emplace_back("cached");
+  s["properties"]["reference"]["properties"]["self_check"] = check.schema("object");
   return s;
 }
 

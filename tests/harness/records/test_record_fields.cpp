@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
+#include <type_traits>
+#include <vector>
 #include <set>
 #include <string>
 
@@ -108,6 +111,52 @@ TEST(RecordFields, EveryBoundedNumberOfMetricsIsInTheMetricTable) {
     EXPECT_EQ(gate_metric_problem(f.key), "") << f.key;
   }
   EXPECT_EQ(gate_metrics().size(), bounded);
+}
+
+// ---- the reader holds every field to its rules ---------------------------------------------------
+
+// What a `visit` says a reader must refuse: a number below the field's minimum, a name outside its
+// choices, for every field of the list, whether it came with a format change (`since`) or not.
+// Each value a rule refuses, with the error the reader must give (what it names).
+template <class T, class Read>
+void expect_every_rule_held(const json& written, Read read) {
+  size_t rules = 0;
+  for (const FieldInfo& r : field_list<T>()) {
+    if (!r.min && !r.choices) continue;
+    ++rules;
+    json bad = written;
+    if (r.min) bad[r.key] = *r.min - 1;
+    else if (r.list) bad[r.key] = json::array({"no_such_name"});
+    else bad[r.key] = "no_such_name";
+    try {
+      read(bad);
+      ADD_FAILURE() << r.key << " = " << bad[r.key].dump() << " was read back";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(r.key), std::string::npos) << r.key << ": " << e.what();
+    }
+  }
+  EXPECT_GT(rules, 0u);
+}
+
+TEST(RecordFields, TheReaderHoldsEveryFieldToItsMinimumAndChoices) {
+  expect_every_rule_held<RunRecord>(to_json(filled<RunRecord>()), [](const json& j) { return from_json(j); });
+  expect_every_rule_held<Metrics>(to_json(filled<Metrics>()), [](const json& j) { return metrics_from_json(j); });
+  expect_every_rule_held<SelfCheck>(to_json(filled<SelfCheck>()), [](const json& j) { return self_check_from_json(j); });
+  // The rules above include fields of the first format (no `since`): a run's sample count and
+  // status, a list of names.
+  std::set<std::string> keys;
+  for (const FieldInfo& r : field_list<RunRecord>())
+    if (r.min || r.choices) keys.insert(r.key);
+  EXPECT_TRUE(keys.count("samples") && keys.count("status") && keys.count("ledger_not_available"));
+}
+
+TEST(RecordFields, SelfCheckWritesExactlyItsVisitedFieldsAndReadsEveryOneBack) {
+  const json j = to_json(filled<SelfCheck>());
+  EXPECT_EQ(keys_of(j), visited_keys<SelfCheck>());
+  EXPECT_EQ(to_json(self_check_from_json(json::parse(j.dump()))), j);
+  json old = j;
+  old.erase("atol");  // records written before the absolute tolerance was a setting
+  EXPECT_EQ(self_check_from_json(old).atol, 0.0);
 }
 
 // ---- the schemas ------------------------------------------------------------------------------------
