@@ -339,6 +339,51 @@ TEST_P(Conformance, Deterministic) {
   EXPECT_TRUE(a == b) << "two runs of the same scene differ";
 }
 
+// Every setting the engine declares (its settings struct's `visit`, as docs/engines.md lists
+// them) refuses a value of the wrong type, a number or count outside its range and a name outside
+// its choices, and an unknown key is refused: each with an error naming engines.NAME.KEY, from
+// the registry's validation and from making the simulator. A new engine's settings are checked
+// here without a test of its own.
+TEST_P(Conformance, EverySettingRefusesABadValueNamingItsKey) {
+  const std::string name = row().engine;
+  const EngineInfo& info = engine_info(name);
+  auto expect_refused = [&](const std::string& key, const SettingValue& bad, const char* what) {
+    Scene s = fixtures::dimensionless_scene();
+    s.engines[name][key] = bad;
+    const std::string want = "engines." + name + "." + key + ":";
+    for (int via = 0; via < 2; ++via) {
+      try {
+        if (via == 0) info.validate(s);
+        else make(s);
+        ADD_FAILURE() << want << " accepted " << what << (via ? " (make_simulator)" : " (validate)");
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << what << ": " << e.what();
+      }
+    }
+  };
+  expect_refused("no_such_setting", 1.0, "an unknown key");
+  const std::vector<SettingDoc> docs = info.describe_settings();
+  ASSERT_FALSE(docs.empty()) << name << " declares no settings";
+  for (const SettingDoc& d : docs) {
+    if (d.type == "number") {
+      expect_refused(d.key, std::string("1e-3"), "a string for a number");
+      expect_refused(d.key, std::nan(""), "NaN");  // outside every range, both bounds included
+    } else if (d.type == "integer") {
+      expect_refused(d.key, 0.5, "a fraction for an integer");
+      expect_refused(d.key, 1LL << 40, "a count past every int range");
+    } else if (d.type == "boolean") {
+      expect_refused(d.key, 1LL, "1 for a boolean");
+    } else if (d.type == "string") {
+      expect_refused(d.key, 1.0, "a number for a string");
+      if (d.allowed != "any string") expect_refused(d.key, std::string("no_such_choice"), "a name outside the choices");
+    } else if (d.type == "array") {
+      expect_refused(d.key, 1.0, "a number for an array");
+    } else {
+      ADD_FAILURE() << d.key << ": a setting type this test does not know: " << d.type;
+    }
+  }
+}
+
 TEST_P(Conformance, NameAndVersionAreTheRegistrys) {
   auto sim = make(fixtures::dimensionless_scene());
   EXPECT_EQ(sim->engine(), row().engine);

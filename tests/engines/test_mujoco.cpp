@@ -72,36 +72,9 @@ TEST(Mujoco, InitialStateMatchesScene) {
   EXPECT_LE((y.w_B - x0.w_B).norm(), 1e-14);
 }
 
-TEST(Mujoco, Deterministic) {
-  const Scene scene = dimensionless_scene();
-  const auto a = make_mujoco_simulator(scene);
-  const auto b = make_mujoco_simulator(scene);
-  a->advance_to(1.0);
-  b->advance_to(1.0);
-  ASSERT_EQ(a->status(), RunStatus::Ok) << a->status_detail();
-  // Same inputs, same single-threaded code path: bit-identical, no tolerance.
-  EXPECT_TRUE(bit_equal(a->observe().state, b->observe().state));
-  EXPECT_NEAR(a->observe().state.t, 1.0, 1e-12);
-  EXPECT_EQ(a->work().steps, b->work().steps);
-  EXPECT_EQ(a->work().solver_iterations, b->work().solver_iterations);
-}
-
 TEST(Mujoco, SettingsErrorsNameTheKey) {
-  {
-    Scene s = dimensionless_scene();
-    s.engines["mujoco"]["no_such_key"] = 1.0;
-    expect_setting_error(s, "no_such_key");
-  }
-  {
-    Scene s = dimensionless_scene();
-    s.engines["mujoco"]["timestep"] = std::string("small");  // wrong type
-    expect_setting_error(s, "timestep");
-  }
-  {
-    Scene s = dimensionless_scene();
-    s.engines["mujoco"]["iterations"] = 2.5;  // wrong type: an integer is expected
-    expect_setting_error(s, "iterations");
-  }
+  // One bad value per setting (type, range, choices) and an unknown key: Conformance.
+  // EverySettingRefusesABadValueNamingItsKey. Here what only this engine's rules say.
   {
     Scene s = dimensionless_scene();
     s.engines["mujoco"]["impratio"] = -1.0;  // out of range
@@ -109,18 +82,8 @@ TEST(Mujoco, SettingsErrorsNameTheKey) {
   }
   {
     Scene s = dimensionless_scene();
-    s.engines["mujoco"]["integrator"] = std::string("RK45");  // not one of the choices
-    expect_setting_error(s, "integrator");
-  }
-  {
-    Scene s = dimensionless_scene();
     s.engines["mujoco"]["solref"] = std::vector<double>{0.002};  // wrong length
     expect_setting_error(s, "solref");
-  }
-  {
-    Scene s = dimensionless_scene();
-    s.engines["mujoco"]["body_frame"] = std::string("origin");  // not one of the choices
-    expect_setting_error(s, "body_frame");
   }
   {
     Scene s = dimensionless_scene();

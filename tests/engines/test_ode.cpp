@@ -63,44 +63,13 @@ TEST(Ode, InitialStateMatchesScene) {
   EXPECT_LE((y.w_B - x0.w_B).norm(), 1e-13);
 }
 
-TEST(Ode, Deterministic) {
-  const Scene scene = dimensionless_scene();
-  const auto a = make_ode_simulator(scene);
-  const auto b = make_ode_simulator(scene);
-  a->advance_to(1.0);
-  b->advance_to(1.0);
-  ASSERT_EQ(a->status(), RunStatus::Ok) << a->status_detail();
-  // Same inputs, same single-threaded code path: bit-identical, no tolerance.
-  EXPECT_TRUE(bit_equal(a->observe().state, b->observe().state));
-  EXPECT_NEAR(a->observe().state.t, 1.0, 1e-12);
-  EXPECT_EQ(a->work().steps, b->work().steps);
-}
-
 TEST(Ode, SettingsErrorsNameTheKey) {
-  {
-    Scene s = dimensionless_scene();
-    s.engines["ode"]["no_such_key"] = 1.0;
-    expect_setting_error(s, "no_such_key");
-  }
-  {
-    Scene s = dimensionless_scene();
-    s.engines["ode"]["timestep"] = std::string("small");
-    expect_setting_error(s, "timestep");
-  }
-  {
-    Scene s = dimensionless_scene();
-    s.engines["ode"]["finite_rotation"] = 1.0;  // wrong type: a bool is expected
-    expect_setting_error(s, "finite_rotation");
-  }
+  // One bad value per setting (type, range, choices) and an unknown key: Conformance.
+  // EverySettingRefusesABadValueNamingItsKey. Here what only this engine's rules say.
   {
     Scene s = dimensionless_scene();
     s.engines["ode"]["soft_erp"] = 1.5;  // out of [0, 1]
     expect_setting_error(s, "soft_erp");
-  }
-  {
-    Scene s = dimensionless_scene();
-    s.engines["ode"]["stepper"] = std::string("rk4");  // not one of the choices
-    expect_setting_error(s, "stepper");
   }
   {
     Scene s = dimensionless_scene();
