@@ -6,10 +6,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "harness/measure/compare.h"
+#include "harness/records/fields.h"
 #include "harness/records/records.h"
 #include "harness/report/document.h"
 #include "harness/report/gnuplot.h"
@@ -383,4 +385,37 @@ TEST(ReportIndex, TheCommandReadsEverySceneDirectory) {
   // A directory with no comparison in it is bad input, exit 2.
   const int rc = std::system((tippe + " report " + (dir.path() / "sweep-x").string() + " --index-verdict 2>/dev/null").c_str());
   EXPECT_EQ(WEXITSTATUS(rc), 2);
+}
+
+// The page shows every number of Metrics' list (its `visit`): changing one changes the page, so
+// a metric added to the list is on the page or named here with the reason it is not.
+TEST(ReportPage, EveryMetricOfTheListIsOnThePage) {
+  TempDir dir{"tippe-pages"};
+  json c = make_comparison(dir.path());
+  // Both sides touch down on the stem, so the page has a stem-contact time to compare.
+  c["reference"]["summary"]["stem_contact_time"] = 1.2;
+  c["engines"][0]["summary"]["stem_contact_time"] = 1.25;
+  c["engines"][0]["metrics"]["stem_contact_event"] = "both";
+  c["engines"][0]["metrics"]["stem_contact_time_abs_error"] = 0.05;
+  c["engines"][0]["metrics"]["stem_contact_time_rel_error"] = 0.05 / 1.2;
+  // Shown from elsewhere in the record, the same number: the energy ledger's section reads each
+  // run's own ledger (its summary), of which these metrics are copies scaled by |E0|; the CPU
+  // column reads the run's summary; the first wrong event is shown by its text, the index only
+  // places it in the alignment's table.
+  const std::set<std::string> elsewhere = {"numerical_energy_max", "numerical_energy_final", "friction_work",
+                                           "normal_work",          "drilling_work",          "impact_energy",
+                                           "elastic_energy_max",   "cpu_seconds",            "first_wrong_event_index"};
+  const std::string base = render_markdown(c);
+  std::vector<std::string> missing, shown_after_all;
+  for (const FieldInfo& f : field_list<Metrics>()) {
+    if (!f.number) continue;
+    json changed = c;
+    json& m = changed["engines"][0]["metrics"];
+    m[f.key] = m[f.key].is_number_integer() ? json(987654) : json(987.654);
+    const bool shown = render_markdown(changed) != base;
+    if (!shown && !elsewhere.count(f.key)) missing.push_back(f.key);
+    if (shown && elsewhere.count(f.key)) shown_after_all.push_back(f.key);
+  }
+  EXPECT_TRUE(missing.empty()) << "metrics the page does not show: " << ::testing::PrintToString(missing);
+  EXPECT_TRUE(shown_after_all.empty()) << "excused but shown: " << ::testing::PrintToString(shown_after_all);
 }
