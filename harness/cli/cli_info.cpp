@@ -8,7 +8,7 @@
 #include "engines/core/registry.h"
 #include "harness/io/scene_io.h"
 #include "harness/records/comparison.h"
-#include "harness/records/record_schemas.h"
+#include "harness/library/schemas.h"
 #include "harness/scene/resolve.h"
 #include "engines/core/simulator.h"
 
@@ -96,7 +96,7 @@ int info(const InfoOptions& o) {
   if (o.metrics) return metrics_table();
   if (!o.schema.empty()) {
     try {
-      std::fputs(record_schema_text(o.schema).c_str(), stdout);
+      std::fputs(generated_schema_text(o.schema).c_str(), stdout);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("info: --schema: ") + e.what());
     }
@@ -158,9 +158,10 @@ Command setup_info(CLI::App& app) {
                 "Print every engine's settings (key, type, default, accepted values) as Markdown: docs/engines.md");
   sub->add_flag("--metrics", o->metrics,
                 "Print the metric table: every metric of a comparison, whether gates and sweeps may bound it, its unit");
+  std::string names;
+  for (const std::string& n : generated_schema_names()) names += (names.empty() ? "" : ", ") + n;
   sub->add_option("--schema", o->schema,
-                  "Print the JSON Schema generated from a record's field list: run-summary or comparison "
-                  "(schemas/NAME.schema.json)");
+                  "Print the JSON Schema generated from a record's field list: " + names + " (schemas/NAME.schema.json)");
   return {sub, [o] { return info(*o); }};
 }
 

@@ -139,6 +139,11 @@ std::string render_table(const std::vector<CheckResult>& results);
 std::string render_junit(const std::vector<CheckResult>& results, const std::string& suite_name);
 // {"format": "tippe-gate-1", "passed", "checks", "failed", "results": [{name, engine, scene, set,
 // passed, seconds, rows: [{kind, metric, value, threshold, measured, required, passed, message}]}]}
+// (the command line and the Python module add "gate_file").
+constexpr const char* kGateResultFormat = "tippe-gate-1";
 nlohmann::json to_json(const std::vector<CheckResult>& results);
+// The text of schemas/gate-result.schema.json: the result's frame (format, gate_file, passed,
+// checks, failed) with "results" from CheckResult's and GateRow's field lists (SchemaBuilder).
+std::string gate_result_schema_text();
 
 }  // namespace tippe

@@ -371,7 +371,7 @@ json to_json(const std::vector<CheckResult>& results) {
     failed += !r.passed;
     list.push_back(JsonWriter::write(r));
   }
-  return json{{"format", "tippe-gate-1"},
+  return json{{"format", kGateResultFormat},
               {"passed", failed == 0},
               {"checks", results.size()},
               {"failed", failed},

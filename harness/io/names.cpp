@@ -38,6 +38,8 @@ size_t utf8_sequence(const std::string& s, size_t i) {
 }  // namespace
 
 const char* const kNameRule = "letters, digits, '.', '_', '-'";
+// Not "." or "..": a character other than '.', or three dots or more.
+const char* const kNamePattern = "^([A-Za-z0-9._-]*[A-Za-z0-9_-][A-Za-z0-9._-]*|\\.\\.\\.+)$";
 
 bool is_valid_name(const std::string& n) {
   return !n.empty() && n != "." && n != ".." && std::all_of(n.begin(), n.end(), [](char c) {

@@ -11,6 +11,9 @@ namespace tippe {
 bool is_valid_name(const std::string& name);
 // What a message says a name must be ("letters, digits, '.', '_', '-'").
 extern const char* const kNameRule;
+// The same rule as a JSON Schema pattern (ECMA-262, with only the tokens JSON Schema advises for
+// portable patterns: no lookahead), for the schemas of records whose names are checked so.
+extern const char* const kNamePattern;
 
 // Whether `s` is well-formed UTF-8 (RFC 3629). Every path and name that reaches a JSON record or
 // an XML report is checked with it first: nlohmann::json throws on invalid UTF-8 while writing.

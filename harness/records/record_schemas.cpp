@@ -1,13 +1,17 @@
-// The record schemas (schemas/run-summary.schema.json, comparison.schema.json): a fixed frame per record, its fields' properties from their `visit`.
+// The record schemas (schemas/run-summary.schema.json, comparison.schema.json, sweep-record.schema.json): a fixed frame per record, its fields' properties from their `visit`.
 #include "harness/records/record_schemas.h"
 
+#include <algorithm>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "harness/records/comparison.h"
 #include "harness/records/fields.h"
 #include "harness/records/records.h"
+#include "harness/records/sweep_schema.h"
 
 namespace tippe {
 
@@ -75,6 +79,16 @@ constexpr const char* kComparisonFrame = R"json({
   "$defs": {}
 })json";
 
+constexpr const char* kSweepRecordFrame = R"json({
+  "$schema": "https://json-schema.org/draft/2020-12/schema",
+  "$id": "sweep-record.schema.json",
+  "title": "tippe sweep record (one line of records.jsonl)",
+  "description": "One point of a sweep: a scene, a setup and a ladder value run on one engine and compared with the reference.",
+  "type": "object",
+  "properties": {"format": {"const": "tippe-sweep-record-1"}},
+  "required": ["format"]
+})json";
+
 ordered run_summary_schema() {
   ordered s = ordered::parse(kRunSummaryFrame);
   SchemaBuilder b;
@@ -110,17 +124,31 @@ ordered comparison_schema() {
   return s;
 }
 
+ordered sweep_record_schema() {
+  ordered s = ordered::parse(kSweepRecordFrame);
+  SweepSchemaBuilder b;
+  const SweepRecord record{};
+  visit(record, b);
+  for (auto& [key, p] : b.properties.items()) s["properties"][key] = p;
+  std::vector<std::string> required = b.required;
+  required.emplace_back("format");
+  std::sort(required.begin(), required.end());
+  s["required"] = required;
+  return s;
+}
+
 }  // namespace
 
-const std::vector<std::string>& generated_schema_names() {
-  static const std::vector<std::string> names = {"run-summary", "comparison"};
+const std::vector<std::string>& record_schema_names() {
+  static const std::vector<std::string> names = {"run-summary", "comparison", "sweep-record"};
   return names;
 }
 
 std::string record_schema_text(const std::string& name) {
   if (name == "run-summary") return run_summary_schema().dump(2) + "\n";
   if (name == "comparison") return comparison_schema().dump(2) + "\n";
-  throw std::invalid_argument("no generated schema \"" + name + "\" (expected run-summary or comparison)");
+  if (name == "sweep-record") return sweep_record_schema().dump(2) + "\n";
+  throw std::invalid_argument("no record schema \"" + name + "\" (expected run-summary, comparison or sweep-record)");
 }
 
 }  // namespace tippe

@@ -113,12 +113,12 @@ class RecordReader {
   }
   // One of `names`.
   static std::string name(const json& j, const std::string& prefix, const char* key,
-                          std::initializer_list<const char*> names) {
+                          const std::vector<std::string>& names) {
     const std::string v = string(j, prefix, key);
     std::string list;
-    for (const char* n : names) {
+    for (const std::string& n : names) {
       if (v == n) return v;
-      list += (list.empty() ? "" : ", ") + std::string(n);
+      list += (list.empty() ? "" : ", ") + n;
     }
     fail(dotted(prefix, key), "\"" + utf8_replaced(v.substr(0, 40)) + "\" is not one of " + list);
   }
@@ -210,10 +210,10 @@ class SweepRecordReader {
       // Records are input: the status and the class (which names the report's CSS classes)
       // must be known ones.
       case SweepField::Check::status:
-        v = R::name(j_, prefix_, f.key(), {"ok", "contact_lost", "diverged", "unphysical", "clamped", "failed"});
+        v = R::name(j_, prefix_, f.key(), run_status_names());
         return;
       case SweepField::Check::run_class:
-        v = R::name(j_, prefix_, f.key(), {"ok", "diverged", "unphysical", "clamped", "failed", "contact_lost"});
+        v = R::name(j_, prefix_, f.key(), run_class_names());
         return;
       case SweepField::Check::criterion:
         v = R::string(j_, prefix_, f.key());
@@ -228,7 +228,13 @@ class SweepRecordReader {
         return;
     }
   }
-  void operator()(const SweepField& f, double& v) { v = R::number(j_, prefix_, f.key(), f.min()); }
+  void operator()(const SweepField& f, double& v) {
+    if (f.is_not_null()) {
+      const json& x = R::at(j_, prefix_, f.key());
+      if (!x.is_number()) R::fail(R::dotted(prefix_, f.key()), std::string("expected a number, got ") + x.type_name());
+    }
+    v = R::number(j_, prefix_, f.key(), f.min());
+  }
   void operator()(const SweepField& f, std::optional<double>& v) { v = R::optional(j_, prefix_, f.key()); }
   void operator()(const SweepField& f, long long& v) { v = R::integer(j_, prefix_, f.key(), f.lo(), f.hi()); }
   void operator()(const SweepField& f, int& v) { v = static_cast<int>(R::integer(j_, prefix_, f.key(), f.lo(), f.hi())); }
@@ -315,6 +321,11 @@ class SweepRecordReader {
 };
 
 }  // namespace
+
+const std::vector<std::string>& run_class_names() {
+  static const std::vector<std::string> names = {"ok", "diverged", "unphysical", "clamped", "failed", "contact_lost"};
+  return names;
+}
 
 json to_json(const SweepRecord& r) {
   json j = SweepWriter::write(r);

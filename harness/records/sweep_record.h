@@ -111,14 +111,16 @@ constexpr double kMaxSearchDecades = 20;
 
 // ---- the sweep record's field list ------------------------------------------------------------
 
-// What a sweep record's `visit` says of one field: its JSON key and the check its reader makes
-// (records are input: every field is checked, an error names the dotted key). The sweep record
+// What a sweep record's `visit` says of one field: its JSON key, its doc and the check its reader
+// makes (records are input: every field is checked, an error names the dotted key); the schema
+// (sweep_schema.h) says the same of each field. The sweep record
 // keeps its own list rather than records/fields.h's because its JSON groups some members
 // ("work", "grid", "class") and its reader's messages are those of a sweep file's.
 class SweepField {
  public:
   enum class Check { none, name, key, label, status, run_class, criterion };
-  SweepField(const char* key) : key_(key) {}
+  // `doc`: the field's unit and meaning, the schema's description (sweep_schema.h).
+  SweepField(const char* key, const char* doc = "") : key_(key), doc_(doc) {}
   // Absent (or null) in records written before it: the reader keeps the default (a label: the
   // number's text; a group: nothing read).
   SweepField since() const { SweepField f = *this; f.since_ = true; return f; }
@@ -139,10 +141,13 @@ class SweepField {
   // An integer in [lo, hi]; a number >= lo.
   SweepField range(long long lo, long long hi) const { SweepField f = *this; f.lo_ = lo; f.hi_ = hi; return f; }
   SweepField at_least(double lo) const { SweepField f = *this; f.min_ = lo; return f; }
+  // A number always written as one: null (which the reader takes as NaN elsewhere) is refused.
+  SweepField not_null() const { SweepField f = *this; f.not_null_ = true; return f; }
   // A group written as null (and null read as nothing) when `null` holds.
   SweepField null_if(bool null) const { SweepField f = *this; f.null_ = null; f.nullable_ = true; return f; }
 
   const char* key() const { return key_; }
+  const char* doc() const { return doc_; }
   bool is_since() const { return since_; }
   Check check() const { return check_; }
   const char* value_key() const { return value_key_; }
@@ -152,11 +157,13 @@ class SweepField {
   double min() const { return min_; }
   bool nullable() const { return nullable_; }
   bool is_null() const { return null_; }
+  bool is_not_null() const { return not_null_; }
 
  private:
   SweepField with(Check c) const { SweepField f = *this; f.check_ = c; return f; }
   const char* key_;
-  bool since_ = false, nullable_ = false, null_ = false;
+  const char* doc_;
+  bool since_ = false, nullable_ = false, null_ = false, not_null_ = false;
   Check check_ = Check::none;
   const char* value_key_ = "";
   double value_ = 0;
@@ -171,84 +178,105 @@ constexpr long long kMaxSweepCount = std::numeric_limits<long long>::max();
 // The fields of records.jsonl's line but "format" (to_json writes it, the reader checks it
 // first), in the order the reader checks them (a record with several faults names the first).
 // `v(field, member)` for a field, `v.group(field, fields)` for a JSON object that groups members
-// of the struct (fields: a callable taking the visitor of the group's own fields).
+// of the struct (fields: a callable taking the visitor of the group's own fields). A field's doc
+// is its description in schemas/sweep-record.schema.json, generated from this list.
 template <class R, class V>
 std::enable_if_t<std::is_same_v<std::remove_const_t<R>, SweepRecord::ReferenceRun>> visit(R& f, V& v) {
-  v(SweepField("status").status(), f.status);
-  v(SweepField("method"), f.method);
-  v(SweepField("class").run_class(), f.run_class);
-  v(SweepField("rtol").at_least(0.0), f.rtol);
-  v(SweepField("cpu_seconds").at_least(0.0), f.cpu_seconds);
+  v(SweepField("status", "how the reference's run ended").status(), f.status);
+  v(SweepField("method", "the reference's integration method"), f.method);
+  v(SweepField("class", "the reference run's stability class").run_class(), f.run_class);
+  v(SweepField("rtol", "the reference's relative tolerance").at_least(0.0), f.rtol);
+  v(SweepField("cpu_seconds", "s: the reference run's CPU time; null: not run").at_least(0.0), f.cpu_seconds);
   v(SweepField("steps").range(0, kMaxSweepCount), f.steps);
   v(SweepField("rhs_evaluations").range(0, kMaxSweepCount), f.rhs_evaluations);
-  v(SweepField("energy_initial"), f.energy_initial);
-  v(SweepField("energy_final"), f.energy_final);
-  v(SweepField("jellett_max_relative_drift"), f.jellett_max_relative_drift);
-  v(SweepField("final_tilt"), f.final_tilt);
+  v(SweepField("energy_initial", "J"), f.energy_initial);
+  v(SweepField("energy_final", "J"), f.energy_final);
+  v(SweepField("jellett_max_relative_drift", "the largest relative drift of Jellett's integral on one surface"),
+    f.jellett_max_relative_drift);
+  v(SweepField("final_tilt", "rad: tilt of the symmetry axis from the vertical at the last sample"), f.final_tilt);
 }
 // The rules of `ladder.search` in a sweep file (sweep_search.h); the reader then checks the
-// range as a whole (check_search).
+// range as a whole (check_search). from, to and resolution are never null: a search has a range.
 template <class R, class V>
 std::enable_if_t<std::is_same_v<std::remove_const_t<R>, SweepSearch>> visit(R& q, V& v) {
-  v(SweepField("criterion").criterion(), q.criterion);
-  v(SweepField("from").at_least(std::numeric_limits<double>::min()), q.from);
-  v(SweepField("to").at_least(q.from), q.to);
-  v(SweepField("resolution").at_least(kMinSearchResolution), q.resolution);
-  v(SweepField("per_decade").range(1, kMaxSearchPerDecade), q.per_decade);
-  v(SweepField("integer").since(), q.integer);
+  v(SweepField("criterion", "\"regime\" or terms joined by \" and \" (sweep_record.h, SearchCriterion)").criterion(),
+    q.criterion);
+  v(SweepField("from", "the key's range: from > 0 (the search is in log10)")
+        .at_least(std::numeric_limits<double>::min())
+        .not_null(),
+    q.from);
+  v(SweepField("to", "the key's range: to > from, at most 20 decades above it").at_least(q.from).not_null(), q.to);
+  v(SweepField("resolution", "log10 units, at most 1: bisection stops when the bracket is narrower")
+        .at_least(kMinSearchResolution)
+        .not_null(),
+    q.resolution);
+  v(SweepField("per_decade", "coarse grid points per decade").range(1, kMaxSearchPerDecade), q.per_decade);
+  v(SweepField("integer", "from and to are whole numbers (an iteration count)").since(), q.integer);
 }
 template <class R, class V>
 std::enable_if_t<std::is_same_v<std::remove_const_t<R>, SweepRecord>> visit(R& r, V& v) {
-  v(SweepField("point_id"), r.point_id);
-  v(SweepField("scene").name(), r.scene);
+  v(SweepField("point_id", "the point's identity in the plan"), r.point_id);
+  v(SweepField("scene", "the scene's name").name(), r.scene);
   v(SweepField("scene_file"), r.scene_file);
-  v(SweepField("physics_hash"), r.physics_hash);
+  v(SweepField("physics_hash", "hash of the scene's physics (engine tables left out)"), r.physics_hash);
   v(SweepField("scene_index").range(0, kMaxSweepIndex), r.scene_index);
-  v(SweepField("setup").name(), r.setup);
+  v(SweepField("setup", "the setup's name").name(), r.setup);
   v(SweepField("engine").name(), r.engine);
-  v(SweepField("set"), r.set);
-  v(SweepField("ladder_key").setting_key(), r.ladder_key);
-  v(SweepField("ladder_value"), r.ladder_value);  // NaN (null): a value that is not a number
+  v(SweepField("set", "KEY=VALUE overrides of the setup"), r.set);
+  v(SweepField("ladder_key", "the setting the ladder steps through").setting_key(), r.ladder_key);
+  v(SweepField("ladder_value", "null: a value that is not a number"), r.ladder_value);
   // Records from before categorical ladders carry only the number.
   v(SweepField("ladder_label").label_of("ladder_value", r.ladder_value).since(), r.ladder_label);
   v(SweepField("setup_index").range(0, kMaxSweepIndex), r.setup_index);
   v(SweepField("ladder_index").range(0, kMaxSweepIndex), r.ladder_index);
-  v.group(SweepField("grid").null_if(r.grid_key.empty()), [&](auto& g) {
+  v.group(SweepField("grid", "the grid's axis; null (or absent) without one").null_if(r.grid_key.empty()), [&](auto& g) {
     g(SweepField("key").setting_key(), r.grid_key);
-    g(SweepField("value"), r.grid_value);
+    g(SweepField("value", "null: a value that is not a number"), r.grid_value);
     g(SweepField("label").label_of("grid.value", r.grid_value), r.grid_label);
     g(SweepField("index").range(0, kMaxSweepIndex), r.grid_index);
   });
-  v(SweepField("repeats").range(1, kMaxRepeats), r.repeats);
-  v(SweepField("duration").at_least(0.0), r.duration);
-  v(SweepField("status").status(), r.status);
-  v(SweepField("status_time"), r.status_time);
+  v(SweepField("repeats", "runs of the point; its times are their minima").range(1, kMaxRepeats), r.repeats);
+  v(SweepField("duration", "s: the scene's run.duration as run").at_least(0.0), r.duration);
+  v(SweepField("status", "how the run ended").status(), r.status);
+  v(SweepField("status_time", "s"), r.status_time);
   v(SweepField("status_detail"), r.status_detail);
-  v(SweepField("inversion_time"), r.inversion_time);
-  v(SweepField("stem_contact_time"), r.stem_contact_time);
-  v(SweepField("reference_inversion_time"), r.reference_inversion_time);
-  v(SweepField("reference_stem_contact_time"), r.reference_stem_contact_time);
-  v(SweepField("metrics"), r.metrics);
+  v(SweepField("inversion_time", "s: this run's first inversion; null: none"), r.inversion_time);
+  v(SweepField("stem_contact_time", "s: this run's first stem contact; null: none"), r.stem_contact_time);
+  v(SweepField("reference_inversion_time", "s: the reference's first inversion; null: none"), r.reference_inversion_time);
+  v(SweepField("reference_stem_contact_time", "s: the reference's first stem contact; null: none"),
+    r.reference_stem_contact_time);
+  v(SweepField("metrics", "the run against the reference; its times and costs are the minima over the repeats"),
+    r.metrics);
   v.group(SweepField("work"), [&](auto& g) {
-    g(SweepField("cpu_seconds").at_least(0.0), r.cpu_seconds);
-    g(SweepField("cpu_seconds_repeats"), r.cpu_seconds_repeats);
-    g(SweepField("wall_seconds").at_least(0.0), r.wall_seconds);
+    g(SweepField("cpu_seconds", "s: the run's own thread, minimum over the repeats").at_least(0.0), r.cpu_seconds);
+    g(SweepField("cpu_seconds_repeats", "s: every repeat, in order"), r.cpu_seconds_repeats);
+    g(SweepField("wall_seconds", "s: minimum over the repeats").at_least(0.0), r.wall_seconds);
     g(SweepField("steps").range(0, kMaxSweepCount), r.steps);
     g(SweepField("rhs_evaluations").range(0, kMaxSweepCount), r.rhs_evaluations);
     g(SweepField("solver_iterations").range(0, kMaxSweepCount), r.solver_iterations);
   });
   v(SweepField("engine_version"), r.engine_version);
   v(SweepField("git_commit"), r.git_commit);
-  v(SweepField("settings"), r.settings);  // every value a string
+  v(SweepField("settings", "every accuracy setting in force, each as text"), r.settings);
   // Absent in records written before classification: the class the status implies.
-  v.group(SweepField("class").since(), [&](auto& g) {
-    g(SweepField("name").run_class(), r.run_class);
-    g(SweepField("time"), r.class_time);
-    g(SweepField("reason"), r.class_reason);
-  });
-  v(SweepField("reference").since(), r.reference);
-  v(SweepField("search").since(), r.search);
+  v.group(SweepField("class", "the stability class of the run (README, 'Stability map'); absent in records written "
+                              "before classification: the class the status implies")
+              .since(),
+          [&](auto& g) {
+            g(SweepField("name").run_class(), r.run_class);
+            g(SweepField("time", "s: when it happened; null: not dated, or ok"), r.class_time);
+            g(SweepField("reason"), r.class_reason);
+          });
+  // Absent (or null) in records written before it, and for a record with no reference run.
+  v(SweepField("reference", "the reference's own run on this scene; null or absent: none").since(), r.reference);
+  v(SweepField("search", "the point's boundary search (a sweep file's ladder.search); null or absent without one")
+        .since(),
+    r.search);
 }
+
+// The stability-map classes a record's class may name (classify.h's RunClassKind, in its
+// order): the reader refuses any other, since they name the report's CSS classes.
+const std::vector<std::string>& run_class_names();
 
 nlohmann::json to_json(const SweepRecord& r);
 // Every field checked for its type and range (indices 0 <= i < kMaxSweepPoints, repeats as in a

@@ -55,6 +55,60 @@ def load_schemas(schema_dir):
     return validator
 
 
+def edited(record, path, value):
+    """A copy of the record with the field at `path` (keys) set to `value`, or removed when it is DROP."""
+    copy = json.loads(json.dumps(record))
+    *outer, last = path
+    target = copy
+    for key in outer:
+        target = target[key]
+    if value is DROP:
+        del target[last]
+    else:
+        target[last] = value
+    return copy
+
+
+DROP = object()
+# Edits of a written record and whether the schema must still take it: for the sweep record,
+# what its reader (sweep_record.cpp) takes (a record without a reference, or from before classes,
+# searches and labels) and refuses; for the gate result, what the command never writes.
+SWEEP_RECORD_EDITS = [
+    (("reference",), None, True), (("reference",), DROP, True), (("class",), DROP, True),
+    (("search",), DROP, True), (("ladder_label",), DROP, True), (("grid",), DROP, True), (("duration",), None, True),
+    (("status",), "exploded", False), (("class", "name"), "fine", False), (("reference", "class"), "fine", False),
+    (("scene",), "a/b", False), (("setup",), "..", False), (("ladder_key",), "a key", False),
+    (("repeats",), 0, False), (("repeats",), 101, False), (("scene_index",), -1, False),
+    (("scene_index",), 100000, False), (("work", "steps"), -1, False), (("work", "cpu_seconds_repeats"), [1.0] * 101, False),
+    (("search",), {"criterion": "regime", "from": 1, "to": 10, "resolution": 0.1, "per_decade": 21}, False),
+    (("search",), {"criterion": "regime", "from": None, "to": 10, "resolution": 0.1, "per_decade": 2}, False),
+    (("search",), {"criterion": "regime", "from": 1, "to": 10, "resolution": 0.1, "per_decade": 2}, True),
+    (("reference", "steps"), 1.5, False), (("metrics",), None, False), (("format",), "tippe-sweep-record-2", False),
+]
+GATE_RESULT_EDITS = [
+    (("checks",), -1, False), (("results", 0, "rows", 0, "kind"), "bogus", False), (("gate_file",), DROP, False),
+    (("results", 0, "seconds"), None, True),
+]
+
+
+def edited_records(validator, work):
+    """Failures of the schemas on edited copies of the first sweep record and of the gate result."""
+    failures = []
+    sweep_record = json.loads((work / "sweep" / "records.jsonl").read_text().splitlines()[0])
+    gate_result = json.loads((work / "gate.json").read_text())
+    for schema, record, edits, takes, refuses in (
+            ("sweep-record.schema.json", sweep_record, SWEEP_RECORD_EDITS, "its reader takes it", "its reader refuses it"),
+            ("gate-result.schema.json", gate_result, GATE_RESULT_EDITS, "the command writes it", "the command never writes it")):
+        for path, value, valid in edits:
+            errors = list(validator(schema).iter_errors(edited(record, path, value)))
+            shown = "dropped" if value is DROP else json.dumps(value)[:40]
+            if valid and errors:
+                failures.append(f"{schema}: {'/'.join(map(str, path))} {shown}: refused, but {takes}: {errors[0].message[:120]}")
+            if not valid and not errors:
+                failures.append(f"{schema}: {'/'.join(map(str, path))} {shown}: taken, but {refuses}")
+    return failures
+
+
 def run(cmd, ok=(0,)):
     p = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     if p.returncode not in ok:
@@ -101,6 +155,7 @@ def main():
                 where = "/".join(map(str, error.absolute_path)) or "(top)"
                 failures.append(f"{path}{':' + str(n) if lines else ''}: {where}: {error.message[:200]}")
         counts[schema] = counts.get(schema, 0) + len(records)
+    failures += edited_records(validator, work)
     if failures:
         print(f"{len(failures)} schema violations:\n  " + "\n  ".join(failures[:50]))
         return 1

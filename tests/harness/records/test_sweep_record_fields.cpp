@@ -1,13 +1,15 @@
-// The sweep record's one field list (`visit`, records/sweep_record.h): every field it lists is written and read back, and every published record reads and writes back byte for byte.
+// The sweep record's one field list (`visit`, records/sweep_record.h): every field it lists is written, read back and described by the generated schema as its reader reads it, and every published record reads and writes back byte for byte.
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <set>
 #include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "harness/records/record_schemas.h"
 #include "harness/records/sweep_record.h"
 #include "tests/support/field_filler.h"
 #include "tests/support/files.h"
@@ -130,8 +132,8 @@ TEST(SweepRecordFields, GroupsAndPartsAbsentInOlderRecordsReadAsTheirDefaults) {
   EXPECT_EQ(back.ladder_label, json(r.ladder_value).dump());
 }
 
-// The committed schema (schemas/sweep-record.schema.json, written by hand) describes every field
-// of the list and no other: a field added to the `visit` fails here until the schema has it.
+// The committed schema (schemas/sweep-record.schema.json, generated from the list) describes
+// every field of the list and no other.
 void schema_keys(const json& properties, const std::string& prefix, std::set<std::string>& out) {
   for (const auto& [k, p] : properties.items()) {
     out.insert(prefix + k);
@@ -150,6 +152,49 @@ TEST(SweepRecordFields, TheCommittedSchemaDescribesEveryListedField) {
   std::set<std::string> described;
   schema_keys(schema.at("properties"), "", described);
   EXPECT_EQ(described, listed);
+}
+
+// The schema and the reader agree on every field: required exactly where a record without it is
+// refused, null allowed exactly where the reader takes null. (A field absent or null is the one
+// fault of each record tried: the filled record is valid.)
+bool reads(const json& j) {
+  try {
+    sweep_record_from_json(j);
+    return true;
+  } catch (const SweepRecordError&) {
+    return false;
+  }
+}
+TEST(SweepRecordFields, TheSchemaRequiresAndAllowsNullExactlyWhereTheReaderDoes) {
+  const json record = to_json(filled_sweep_record());
+  ASSERT_TRUE(reads(record));
+  const json schema = json::parse(record_schema_text("sweep-record"));
+  size_t fields = 0;
+  std::function<void(const json&, const json::json_pointer&)> walk = [&](const json& object, const json::json_pointer& at) {
+    const json& required = object.at("required");
+    for (const auto& [key, p] : object.at("properties").items()) {
+      const json::json_pointer field = at / key;
+      const std::string name = field.to_string();
+      ++fields;
+      json without = record;
+      without.at(at).erase(key);
+      const bool is_required = std::find(required.begin(), required.end(), key) != required.end();
+      EXPECT_EQ(reads(without), !is_required) << name << (is_required ? " is required but reads when absent"
+                                                                        : " is not required but is refused when absent");
+      json nulled = record;
+      nulled[field] = nullptr;
+      // A value null is "not a number": its label must then be a name (the one rule across fields).
+      if (name == "/ladder_value") nulled["ladder_label"] = "a_name";
+      if (name == "/grid/value") nulled["grid"]["label"] = "a_name";
+      const json type = p.value("type", json());
+      const bool may_be_null = type == "null" || (type.is_array() && std::find(type.begin(), type.end(), "null") != type.end());
+      EXPECT_EQ(reads(nulled), may_be_null) << name << (may_be_null ? " may be null but is refused null"
+                                                                    : " may not be null but reads null");
+      if (p.contains("properties")) walk(p, field);
+    }
+  };
+  walk(schema, json::json_pointer());
+  EXPECT_GT(fields, 50u);
 }
 
 // The published records (reports/sweep-*/records.jsonl) read back, and write back every field
