@@ -1,4 +1,4 @@
-// Running `tippe sweep` (alone or under mpirun) from the tests and comparing the records it leaves.
+// Running `tippe sweep` (alone or under mpirun) from the tests and comparing the records it leaves, and the sweeps the tests of shards and ranks share.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/files.h"
 #include "tests/support/fixtures.h"
 #include "tests/support/process.h"
 #include "tests/support/records.h"
@@ -64,6 +65,74 @@ inline void expect_same_records(const std::filesystem::path& expected_dir, const
       EXPECT_EQ(f.value(), it->second.value(f.key(), nlohmann::json())) << "point " << id << " field " << f.key();
     FAIL() << "point " << id << " differs";
   }
+}
+
+// ---- sweeps the tests of shards and ranks share ------------------------------------------------
+
+inline const std::string kSmoke = TIPPE_SOURCE_DIR "/harness/sweeps/smoke.toml";
+
+// One local run of the smoke sweep, shared by the tests that compare against it.
+inline const std::filesystem::path& local_smoke() {
+  static TempDir dir("tippe-dist-local");
+  static bool done = false;
+  if (!done) {
+    const std::filesystem::path out = dir.path() / "local";
+    EXPECT_EQ(run(tippe_sweep({kSmoke, "--out", out.string(), "--jobs", "1"}), dir.path() / "log"), 0)
+        << slurp(dir.path() / "log");
+    done = true;
+  }
+  static const std::filesystem::path out = dir.path() / "local";
+  return out;
+}
+
+// A sweep whose second scene's reference fails on its first step: the stiff scene on an explicit
+// method (Bulirsch-Stoer at k = 1e4).
+inline std::string failing_reference_sweep(const TempDir& dir) {
+  std::string scene = slurp(fixtures::kSourceDir + "/harness/scenes/extremes/k_high.toml");
+  const std::string from = "method = \"rosenbrock4\"";
+  scene.replace(scene.find(from), from.size(), "method = \"bulirsch_stoer\"");
+  dir.write("stiff_explicit.toml", scene);
+  return dir.write("fails.toml", "description = \"a reference that fails\"\nscenes = [\"" + fixtures::kSourceDir +
+                                     "/harness/scenes/toy.toml\", \"stiff_explicit.toml\"]\n"
+                                     "[[setup]]\nname = \"ode\"\nengine = \"ode\"\n"
+                                     "ladder.key = \"engines.ode.timestep\"\nladder.values = [1e-3, 2e-3]\n");
+}
+
+// A failing reference is a result: its scene's points are recorded failed with its reason, the
+// other scene's points run, the report lists the reference as failed, and the sweep exits 0.
+inline void expect_failed_reference_recorded(const std::filesystem::path& out, const std::string& log) {
+  std::map<std::string, size_t> by_scene, failed;
+  for (const nlohmann::json& r : lines_of(out / "records.jsonl")) {
+    const std::string scene = r.at("scene");
+    ++by_scene[scene];
+    if (r.at("status") == "failed") {
+      ++failed[scene];
+      EXPECT_EQ(r.at("status_detail").get<std::string>().rfind("not run: the reference run of k_high failed at t = ", 0), 0u)
+          << r.dump();
+      EXPECT_EQ(r.at("class").at("name"), "failed");
+      EXPECT_EQ(r.at("reference").at("status"), "failed");
+    }
+  }
+  EXPECT_EQ(by_scene["toy"], 2u) << log;
+  EXPECT_EQ(failed["toy"], 0u) << log;
+  EXPECT_EQ(by_scene["k_high"], 2u) << log;
+  EXPECT_EQ(failed["k_high"], 2u) << log;
+  EXPECT_NE(log.find("tippe: warning: the reference run of k_high failed"), std::string::npos) << log;
+  const std::string report = slurp(out / "report.md");
+  EXPECT_NE(report.find("k_high"), std::string::npos) << report;
+  EXPECT_NE(report.find("| failed |"), std::string::npos) << report;
+}
+
+// A grid and a categorical ladder: every point is an ordinary point, so shards, merges, resumed
+// runs and MPI ranks give the records of one local run.
+inline std::string grid_sweep(const TempDir& dir) {
+  return dir.write("grid.toml", "description = \"a grid\"\nduration = 0.3\nscenes = [\"" + fixtures::kSourceDir +
+                                    "/harness/scenes/toy.toml\"]\n"
+                                    "[[setup]]\nname = \"ode\"\nengine = \"ode\"\n"
+                                    "ladder = { key = \"engines.ode.timestep\", values = [1e-3, 2e-3] }\n"
+                                    "grid = { key = \"engines.ode.friction_model\", values = [\"approx1\", \"box\"] }\n"
+                                    "[[setup]]\nname = \"mujoco\"\nengine = \"mujoco\"\n"
+                                    "ladder = { key = \"engines.mujoco.body_frame\", values = [\"com\", \"ball_centre\"] }\n");
 }
 
 // ---- MPI --------------------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-// Tests of the sweep analysis on synthetic records (harness/report/sweep_analysis.h): orders of convergence, the cheapest setting below each bound, the regime along the step, and the sweep report's Markdown.
+// Tests of the sweep analysis on synthetic records (harness/report/sweep_analysis.h): orders of convergence, the cheapest setting below each bound, the regime along the step, the modelling choices that move the verdict, and the sweep report's Markdown.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,6 +15,24 @@ using namespace tippe;
 namespace {
 
 using fixtures::point;
+
+// A grid point of the Modelling-choices fixtures: scene s, the setup's choice at `dt`.
+SweepRecord choice_point(const std::string& setup, long long grid_index, const std::string& choice, long long ladder_index,
+                         double dt, std::optional<double> inversion) {
+  SweepRecord r = point("mujoco", setup, dt, 1e-3 / dt, std::nullopt);
+  r.scene = "s";
+  r.point_id = setup + choice + std::to_string(ladder_index);
+  r.ladder_index = ladder_index;
+  r.grid_key = "engines.mujoco." + setup;
+  r.grid_label = choice;
+  r.grid_index = grid_index;
+  r.inversion_time = inversion;
+  if (inversion) {
+    r.metrics.inversion_event = "both";
+    r.metrics.inversion_time_rel_error = *inversion / 10.0 - 1;
+  }
+  return r;
+}
 
 }  // namespace
 
@@ -183,4 +201,82 @@ TEST(SweepReport, MarkdownNamesTheCheapestPointsAndOrders) {
   // Duplicated point ids (a line written twice) count once.
   recs.push_back(recs.front());
   EXPECT_EQ(render_sweep_markdown(recs), md);
+}
+
+// ---- modelling choices -----------------------------------------------------------------------
+
+TEST(SweepLadders, ModellingChoicesFindWhatMovesTheVerdict) {
+  std::vector<SweepRecord> recs;
+  long long setup_index = 0;
+  const std::vector<double> steps = {1e-3, 5e-4};
+  // body_frame: at the coarse step ball_centre does not invert (the regime moves); cone:
+  // pyramidal inverts 5 % later; noslip_iterations: 0.5 % apart, within the 1 % threshold.
+  const struct {
+    std::string setup, a, b;
+    std::vector<std::optional<double>> ta, tb;
+  } fixtures[] = {
+      {"body_frame", "com", "ball_centre", {4.0, 4.0}, {std::nullopt, 4.01}},
+      {"cone", "elliptic", "pyramidal", {4.0, 4.0}, {4.1, 4.2}},
+      {"noslip_iterations", "0", "10", {4.0, 4.0}, {4.01, 4.02}},
+  };
+  for (const auto& f : fixtures) {
+    for (long long k = 0; k < 2; ++k) {
+      SweepRecord a = choice_point(f.setup, 0, f.a, k, steps[k], f.ta[k]);
+      SweepRecord b = choice_point(f.setup, 1, f.b, k, steps[k], f.tb[k]);
+      if (f.setup == "noslip_iterations") a.grid_value = 0, b.grid_value = 10;
+      a.setup_index = b.setup_index = setup_index;
+      recs.push_back(a);
+      recs.push_back(b);
+    }
+    ++setup_index;
+  }
+  const std::vector<ChoiceEffect> effects = modelling_choices(recs);
+  ASSERT_EQ(effects.size(), 3u);
+  const ChoiceEffect& frame = effects[0];
+  EXPECT_EQ(frame.key, "engines.mujoco.body_frame");
+  EXPECT_EQ(frame.values, (std::vector<std::string>{"com", "ball_centre"}));
+  EXPECT_EQ(frame.steps, 2u);
+  EXPECT_TRUE(frame.regime_moves);
+  EXPECT_EQ(frame.regime_at, "timestep = 0.001");
+  EXPECT_EQ(frame.regime_steps, 1u);
+  EXPECT_EQ(frame.regime_outcomes,
+            (std::vector<std::string>{"com: inverts at 4 (the reference's regime)", "ball_centre: does not invert"}));
+  EXPECT_TRUE(frame.moves());
+  const ChoiceEffect& cone = effects[1];
+  EXPECT_FALSE(cone.regime_moves);
+  ASSERT_TRUE(cone.largest_spread);
+  EXPECT_NEAR(*cone.largest_spread, 0.05, 1e-12);
+  EXPECT_EQ(cone.spread_at, "timestep = 0.0005");
+  EXPECT_TRUE(cone.time_moves());
+  const ChoiceEffect& noslip = effects[2];
+  EXPECT_FALSE(noslip.regime_moves);
+  ASSERT_TRUE(noslip.largest_spread);
+  EXPECT_NEAR(*noslip.largest_spread, 0.005, 1e-12);
+  EXPECT_FALSE(noslip.moves());
+
+  const std::string md = render_sweep_markdown(recs);
+  EXPECT_NE(md.find("## Modelling choices"), std::string::npos) << md;
+  EXPECT_NE(md.find("mujoco: body_frame moves it (s (body_frame): the regime at timestep = 0.001 (1 of 2 steps)). cone moves it (s "
+                    "(cone): the inversion time by 5 % at timestep = 0.0005). noslip_iterations does not move the "
+                    "verdict (s (noslip_iterations): within 0.5 %)."),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| mujoco | s | inverts at 10 | body_frame | engines.mujoco.body_frame | com, ball_centre | moves the regime | at "
+                    "timestep = 0.001 (1 of 2 steps): com: inverts at 4 (the reference's regime); ball_centre: does not invert;"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| moves the inversion time by 5 % | largest: inversion times 5 % apart at timestep = 0.0005 "
+                    "(elliptic 4, pyramidal 4.2) |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| noslip_iterations | engines.mujoco.noslip_iterations | 0, 10 | does not move the verdict |"),
+            std::string::npos)
+      << md;
+  // One line per grid value wherever the report walks a ladder.
+  EXPECT_NE(md.find("| cone cone=pyramidal | mujoco |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| s, cone=pyramidal |"), std::string::npos) << md;
+  // A sweep without choices has no such section.
+  std::vector<SweepRecord> plain = {point("ode", "ode", 1e-3, 1, 0.01)};
+  plain[0].scene = "s";
+  EXPECT_EQ(render_sweep_markdown(plain).find("Modelling choices"), std::string::npos);
 }

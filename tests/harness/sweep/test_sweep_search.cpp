@@ -1,4 +1,4 @@
-// Tests of boundary searches in sweeps (`ladder.search`): the bisection on synthetic criteria, the plan's waves with a fake runner (resume, shards), the report's and gates' boundaries, bad input, and the shipped boundaries sweep.
+// Tests of boundary searches in sweeps (harness/sweep/sweep_search.cpp): the bisection on synthetic criteria, the boundaries from records and in the report, bad input, and the shipped boundaries sweep (the plan's waves: test_sweep_search_plan.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "harness/gating/gate.h"
-#include "harness/gating/gate_boundary.h"
 #include "engines/core/simulator.h"
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
@@ -18,9 +17,9 @@
 #include "harness/sweep/sweep_search.h"
 #include "tests/support/files.h"
 #include "tests/support/process.h"
-#include "tests/support/records.h"
 #include "harness/report/sweep_analysis.h"
 #include "tests/support/fixtures.h"
+#include "tests/support/sweep_searches.h"
 
 namespace fs = std::filesystem;
 using namespace tippe;
@@ -32,36 +31,7 @@ const std::string& kSource = fixtures::kSourceDir;
 const std::string& kBinary = fixtures::kTippeBinary;
 const std::string kScenes = kSource + "/harness/scenes/";
 
-SweepSearch search(double from, double to, double resolution, const std::string& criterion = "regime") {
-  SweepSearch s;
-  s.from = from;
-  s.to = to;
-  s.resolution = resolution;
-  s.criterion = criterion;
-  return s;
-}
-
-// Runs a search on a synthetic criterion the way the sweep does: every point of `next` is run (its
-// outcome becomes known), then the search is replayed, until it asks for nothing.
-struct Synthetic {
-  SearchReplay replay;
-  std::map<std::string, bool> run;  // value text -> criterion
-  size_t waves = 0;
-};
-Synthetic run_synthetic(const SweepSearch& s, const std::function<bool(double)>& criterion) {
-  Synthetic out;
-  const auto outcome = [&](const std::string& text) -> std::optional<bool> {
-    const auto it = out.run.find(text);
-    if (it == out.run.end()) return std::nullopt;
-    return it->second;
-  };
-  for (;;) {
-    out.replay = replay_search(s, outcome);
-    if (out.replay.finished()) return out;
-    ++out.waves;
-    for (const SearchStep& st : out.replay.next) out.run[search_value_text(st.value)] = criterion(st.value);
-  }
-}
+using namespace tippe::fixtures;
 
 // ---- the bisection on synthetic criteria ----------------------------------------------------
 
@@ -166,33 +136,6 @@ TEST(SweepSearch, IntegerSearchOfAnIterationCountLoads) {
 
 // ---- records and the report's boundaries ----------------------------------------------------
 
-// Records of a synthetic search as a sweep would write them: the regime criterion, the reference
-// inverting; the run inverts (in the regime) where `passes` says so.
-std::vector<SweepRecord> synthetic_records(const SweepSearch& s, const std::function<bool(double)>& passes,
-                                           const std::string& scene, long long scene_index) {
-  const Synthetic r = run_synthetic(s, passes);
-  std::vector<SweepRecord> out;
-  const auto add = [&](const SearchStep& st) {
-    SweepRecord x;
-    x.point_id = scene + search_value_text(st.value);
-    x.scene = scene;
-    x.scene_index = scene_index;
-    x.setup = "ode-regime";
-    x.engine = "ode";
-    x.ladder_key = "engines.ode.timestep";
-    x.ladder_value = st.value;
-    x.ladder_label = search_value_text(st.value);
-    x.ladder_index = st.ladder_index;
-    x.search = s;
-    x.reference_inversion_time = 4.33;
-    if (passes(st.value)) x.inversion_time = 4.4;
-    x.cpu_seconds = 1e-4 / st.value;
-    out.push_back(x);
-  };
-  for (const SearchStep& st : r.replay.known) add(st);
-  return out;
-}
-
 TEST(SweepSearch, BoundariesFromRecordsGiveTheBracketRunsAndCost) {
   const SweepSearch s = search(1e-6, 1e-1, 0.05);
   std::vector<SweepRecord> records = synthetic_records(s, [](double v) { return v <= 3.7e-3; }, "toy_viscous", 0);
@@ -253,168 +196,6 @@ TEST(SweepSearch, RecordsCarryTheirSearchAndRefuseABadOne) {
   j = to_json(r);
   j["search"]["to"] = 1e-7;
   EXPECT_THROW(sweep_record_from_json(j), SweepRecordError);
-}
-
-// ---- the plan's waves, with a fake runner ---------------------------------------------------
-
-std::string sweep_text(const std::string& extra = "") {
-  return "description = \"search planner test\"\n"
-         "scenes = [ \"" + kScenes + "toy.toml\", { file = \"" + kScenes + "toy_viscous.toml\", duration = 4.6 } ]\n"
-         "[[setup]]\nname = \"ode-regime\"\nengine = \"ode\"\n"
-         "ladder.search = { key = \"engines.ode.timestep\", from = 1e-6, to = 1e-1, criterion = \"regime\" }\n"
-         "[[setup]]\nname = \"bullet-grid\"\nengine = \"bullet\"\n"
-         "ladder.search = { key = \"engines.bullet.timestep\", from = 1e-5, to = 1e-2, criterion = "
-         "\"inversion_time_rel_error <= 0.01\", resolution = 0.1 }\n"
-         "grid = { key = \"engines.bullet.friction_directions\", values = [2, 1] }\n"
-         "[[setup]]\nname = \"ode-ladder\"\nengine = \"ode\"\n"
-         "ladder = { key = \"engines.ode.timestep\", values = [1e-3, 1e-2] }\n" +
-         extra;
-}
-
-// The synthetic physics: each search's own boundary, a function of scene, setup and grid value.
-double synthetic_boundary(const SweepPoint& p) {
-  return 1e-4 * (1 + static_cast<double>(p.scene_index)) * (1 + 3 * static_cast<double>(p.setup_index)) *
-         (1 + 0.5 * static_cast<double>(p.grid_index));
-}
-
-SweepRecord fake_record(const SweepPlan& plan, const SweepPoint& p) {
-  const SweepSetup& s = plan.spec.setups[p.setup_index];
-  SweepRecord r;
-  r.point_id = p.id;
-  r.scene = p.scene.name;
-  r.scene_index = static_cast<long long>(p.scene_index);
-  r.setup = s.name;
-  r.engine = s.engine;
-  r.set = s.set;
-  r.ladder_key = s.ladder_key;
-  r.ladder_value = p.ladder_value;
-  r.ladder_label = p.ladder_label;
-  r.setup_index = static_cast<long long>(p.setup_index);
-  r.ladder_index = static_cast<long long>(p.ladder_index);
-  if (s.has_grid()) {
-    r.grid_key = s.grid_key;
-    r.grid_value = s.grid_values[p.grid_index];
-    r.grid_label = s.grid_labels[p.grid_index];
-    r.grid_index = static_cast<long long>(p.grid_index);
-  }
-  r.search = s.search;
-  r.reference_inversion_time = 4.33;
-  const bool in = p.ladder_value <= synthetic_boundary(p);
-  if (in) r.inversion_time = 4.33 * (1 + 1e-3);
-  r.metrics.inversion_time_rel_error = in ? 1e-3 : 0.5;
-  r.engine_version = r.git_commit = "fake";
-  r.cpu_seconds = 1e-3 / p.ladder_value;
-  return r;
-}
-
-// What run_search_sweep does, with fake runs: replay the records into the plan, then run the
-// missing points of the share wave by wave. Stops (an interruption) after `budget` new records.
-std::vector<SweepRecord> fake_sweep(SweepPlan plan, std::vector<SweepRecord> records, size_t budget = 1000000,
-                                    const std::optional<SweepShard>& shard = std::nullopt, size_t* waves = nullptr) {
-  extend_search_plan(plan, records);
-  for (size_t wave = 0;; ++wave) {
-    if (wave > 0) {
-      const std::vector<SearchPoint> f = search_frontier(plan, records);
-      if (f.empty()) break;
-      // The wave reaches every rank as text.
-      add_search_points(plan, decode_search_points(encode_search_points(f)));
-    }
-    std::set<std::string> done;
-    for (const SweepRecord& r : records) done.insert(r.point_id);
-    std::vector<size_t> share;
-    if (shard) {
-      share = shard_points(plan, *shard);
-    } else {
-      for (size_t i = 0; i < plan.points.size(); ++i) share.push_back(i);
-    }
-    for (size_t i : share) {
-      if (done.count(plan.points[i].id)) continue;
-      if (budget-- == 0) return records;
-      records.push_back(fake_record(plan, plan.points[i]));
-    }
-    if (waves) *waves = wave + 1;
-  }
-  return records;
-}
-
-std::map<std::string, json> keyed(const std::vector<SweepRecord>& records) {
-  std::map<std::string, json> m;
-  for (const SweepRecord& r : records) EXPECT_TRUE(m.emplace(r.point_id, without_timings(to_json(r))).second) << r.point_id;
-  return m;
-}
-
-TEST(SweepSearchPlan, WavesFindEachSearchsBoundaryAndKeepTheLadders) {
-  TempDir dir;
-  const SweepPlan plan = load_sweep(dir.write("s.toml", sweep_text()));
-  // Planned up front: 2 scenes x (6 coarse + 2 x 4 coarse + 2 ladder values).
-  EXPECT_EQ(plan.planned, 2u * (6 + 8 + 2));
-  EXPECT_EQ(plan.points.size(), plan.planned);
-  size_t waves = 0;
-  const std::vector<SweepRecord> records = fake_sweep(plan, {}, 1000000, std::nullopt, &waves);
-  const std::vector<SearchBoundary> b = search_boundaries(records);
-  ASSERT_EQ(b.size(), 2u * (1 + 2));
-  for (const SearchBoundary& x : b) {
-    SweepPoint p;
-    p.scene_index = static_cast<size_t>(x.scene_index);
-    p.setup_index = static_cast<size_t>(x.setup_index);
-    p.grid_index = static_cast<size_t>(x.grid_index);
-    const double truth = synthetic_boundary(p);
-    ASSERT_EQ(x.status, "found") << x.scene << " " << x.setup;
-    EXPECT_LE(*x.boundary, truth);
-    EXPECT_GT(*x.beyond, truth);
-    EXPECT_LT(std::log10(*x.beyond / *x.boundary), x.search.resolution);
-  }
-  // Each search is independent; the waves are the longest bisection plus the coarse wave.
-  EXPECT_LE(waves, 1u + 5u);
-  // Every id distinct, every index below the sweep's bound.
-  const auto m = keyed(records);
-  EXPECT_EQ(m.size(), records.size());
-  for (const SweepRecord& r : records) EXPECT_LT(r.ladder_index, static_cast<long long>(kMaxSweepPoints));
-}
-
-TEST(SweepSearchPlan, InterruptedAndResumedGivesTheRecordsOfAnUninterruptedSearch) {
-  TempDir dir;
-  const std::string file = dir.write("s.toml", sweep_text());
-  const std::vector<SweepRecord> whole = fake_sweep(load_sweep(file), {});
-  // Interrupted after every possible number of records: mid coarse grid, mid bisection, at the end.
-  for (size_t cut = 0; cut <= whole.size(); cut += 3) {
-    const std::vector<SweepRecord> part = fake_sweep(load_sweep(file), {}, cut);
-    ASSERT_EQ(part.size(), std::min(cut, whole.size()));
-    // A new process: the plan from the file, the records from the directory.
-    const std::vector<SweepRecord> resumed = fake_sweep(load_sweep(file), part);
-    EXPECT_EQ(keyed(resumed), keyed(whole)) << "interrupted after " << cut << " records";
-  }
-}
-
-TEST(SweepSearchPlan, ShardsKeepEachSearchWholeAndTogetherGiveTheWholeSweep) {
-  TempDir dir;
-  const std::string file = dir.write("s.toml", sweep_text());
-  const std::vector<SweepRecord> whole = fake_sweep(load_sweep(file), {});
-  std::vector<SweepRecord> merged;
-  std::map<std::tuple<long long, long long, long long>, int> owner;
-  for (int i = 0; i < 3; ++i) {
-    const std::vector<SweepRecord> part = fake_sweep(load_sweep(file), {}, 1000000, SweepShard{i, 3});
-    for (const SweepRecord& r : part) {
-      if (r.search) {
-        const auto [it, fresh] = owner.emplace(std::make_tuple(r.scene_index, r.setup_index, r.grid_index), i);
-        EXPECT_EQ(it->second, i) << "a search split over shards " << it->second << " and " << i;
-        (void)fresh;
-      }
-      merged.push_back(r);
-    }
-  }
-  EXPECT_EQ(keyed(merged), keyed(whole));
-}
-
-TEST(SweepSearchPlan, PointIdsHashTheSearch) {
-  TempDir dir;
-  const SweepPlan a = load_sweep(dir.write("a.toml", sweep_text()));
-  std::string text = sweep_text();
-  text.replace(text.find("criterion = \"regime\""), 20, "criterion = \"tilt_rms_error <= 0.1\"");
-  const SweepPlan b = load_sweep(dir.write("b.toml", text));
-  EXPECT_NE(a.points[0].id, b.points[0].id);
-  EXPECT_NE(a.plan_hash, b.plan_hash);
-  EXPECT_EQ(a.points[0].ladder_label, "1e-06");
 }
 
 // ---- bad input ------------------------------------------------------------------------------
@@ -559,39 +340,6 @@ TEST(SweepSearchInput, SetupScenesNameScenesOfTheSweep) {
     EXPECT_EQ(std::string(e.what()), file + ": setup[2].scenes[1]: \"nope\" is not the name of a scene of this sweep "
                                             "(expected one of: toy, toy_viscous)");
   }
-}
-
-// ---- gates on a boundary --------------------------------------------------------------------
-
-TEST(SweepSearchGate, BoundaryCheckJudgesTheSearchFromRecords) {
-  const SweepSearch s = search(1e-6, 1e-1, 0.05);
-  const std::vector<SweepRecord> records = synthetic_records(s, [](double v) { return v <= 3.7e-3; }, "toy_viscous", 0);
-  BoundaryCheck c;
-  c.name = "ode-step";
-  c.setup = "ode-regime";
-  c.scene = "toy_viscous";
-  c.require = parse_bound_text("max_safe_timestep >= 1e-3");
-  CheckResult r = evaluate_boundary(c, records);
-  EXPECT_TRUE(r.passed) << render_table({r});
-  c.require = parse_bound_text("max_safe_timestep >= 1e-2");
-  r = evaluate_boundary(c, records);
-  EXPECT_FALSE(r.passed);
-  const std::string table = render_table({r});
-  EXPECT_NE(table.find("max_safe_timestep 0.00"), std::string::npos) << table;
-  EXPECT_NE(table.find(" < 0.01 (regime; bracket "), std::string::npos) << table;
-  // A criterion that comes and goes fails unless allowed.
-  const std::vector<SweepRecord> wavy =
-      synthetic_records(s, [](double v) { return v < 3e-5 || (v > 2e-3 && v < 4e-2); }, "toy_viscous", 0);
-  c.require = parse_bound_text("max_safe_timestep >= 1e-5");
-  r = evaluate_boundary(c, wavy);
-  EXPECT_FALSE(r.passed);
-  EXPECT_NE(render_table({r}).find("monotonic"), std::string::npos);
-  c.allow_non_monotonic = true;
-  EXPECT_TRUE(evaluate_boundary(c, wavy).passed);
-  // Nothing safe, or no record of the search: fails.
-  EXPECT_FALSE(evaluate_boundary(c, synthetic_records(s, [](double) { return false; }, "toy_viscous", 0)).passed);
-  c.scene = "toy";
-  EXPECT_FALSE(evaluate_boundary(c, records).passed);
 }
 
 }  // namespace
