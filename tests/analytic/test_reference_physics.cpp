@@ -7,6 +7,8 @@
 
 #include "analytic/initial_state.h"
 #include "analytic/reference_model.h"
+#include "tests/support/fixtures.h"
+#include "analytic/contact_dynamics.h"
 
 namespace tippe {
 namespace {
@@ -316,6 +318,71 @@ TEST(ReferencePhysics, LeineGlockerTop) {
   twin.advance_to(4.0);
   // A/C = 9/7 = 1.29 > 1 + alpha = 1.2: the twin cannot turn over.
   EXPECT_FALSE(first_event(twin, "stem_contact"));
+}
+
+// ---- The reference's right-hand side at t = 0, against hand-derived values -------------------------
+
+struct Rhs {
+  StateVector dydt;
+  ContactForces f;
+};
+
+Rhs reference_rhs(const Scene& s, const BodyState& x, bool stick) {
+  const ContactDynamics dyn(BodyModel::from_scene(s), s.contact);
+  ContactMode mode;
+  mode.slot[0].active = true;
+  mode.slot[0].stick = stick;
+  Rhs r;
+  r.f = dyn.evaluate(pack(x), mode, &r.dydt);
+  return r;
+}
+
+TEST(ReferenceRightHandSide, UprightAtRestHasZeroAccelerationAndWeightOnTheBall) {
+  Scene s = fixtures::dimensionless_scene();
+  s.initial.tilt = 0.0;
+  s.initial.spin = 0.0;
+  const BodyState x = scene_initial_state(s);
+  const Rhs r = reference_rhs(s, x, true);
+  // State order: p (0-2), v (3-5), q (6-9), w (10-12). At rest every derivative is 0 and the
+  // floor carries the weight: F_n = M g. Round-off of one linear solve: 1e-14.
+  for (int i = 0; i < 13; ++i) EXPECT_NEAR(r.dydt[static_cast<size_t>(i)], 0.0, 1e-14) << "component " << i;
+  EXPECT_NEAR(r.f.normal[0], s.mass.mass * s.gravity, 1e-14);
+}
+
+TEST(ReferenceRightHandSide, SpinningUprightTopOnlyTurns) {
+  // w_B = n e_Z about the vertical: the contact lies on the axis, below G, so v_C = w x R_C = 0,
+  // no friction; w x I w = 0 for w along a principal axis. Hence dv/dt = 0, dw/dt = 0,
+  // F_n = M g, and dq/dt = q (0, w_B) / 2 = (0, 0, 0, n / 2) for q = 1. With zero slip the
+  // Coulomb contact sticks (the mode the reference settles into at this state).
+  Scene s = fixtures::dimensionless_scene();
+  s.initial.tilt = 0.0;
+  const double n = s.initial.spin;
+  const BodyState x = scene_initial_state(s);
+  const Rhs r = reference_rhs(s, x, true);
+  const double expected[13] = {0, 0, 0, 0, 0, 0, 0, 0, 0, n / 2, 0, 0, 0};
+  for (int i = 0; i < 13; ++i) EXPECT_NEAR(r.dydt[static_cast<size_t>(i)], expected[i], 1e-14) << "component " << i;
+  EXPECT_NEAR(r.f.normal[0], s.mass.mass * s.gravity, 1e-14);
+  EXPECT_NEAR(r.f.slip_W[0].norm(), 0.0, 1e-15);
+}
+
+TEST(ReferenceRightHandSide, TiltedSpinningTopSlidesAgainstItsSlip) {
+  // Tilt theta about the lab x axis: e_Z = (0, -sin theta, cos theta). With w = n e_Z and
+  // v_G = 0, v_C = w x R_C with R_C = z_O e_Z - R e_z: v_C = -n R e_Z x e_z = (n R sin theta, 0, 0).
+  // Coulomb sliding: F_t = -mu F_n v_C / |v_C|, so dv/dt = (-mu F_n / M, 0, F_n / M - g), and
+  // the power balance at v_G = 0: d/dt (w.I w / 2) = n C dw_Z/dt = F_t . v_C = -mu F_n n R sin theta.
+  Scene s = fixtures::dimensionless_scene();
+  const double n = s.initial.spin, th = s.initial.tilt, R = s.body.sphere_radius, mu = s.contact.mu;
+  const double M = s.mass.mass, C = s.mass.inertia_axial;
+  const BodyState x = scene_initial_state(s);
+  ASSERT_NEAR(x.w_B.z(), n, 1e-15);
+  const Rhs r = reference_rhs(s, x, false);
+  const double f_n = r.f.normal[0];
+  ASSERT_GT(f_n, 0.0);
+  EXPECT_NEAR((r.f.slip_W[0] - Vec3(n * R * std::sin(th), 0, 0)).norm(), 0.0, 1e-14);
+  EXPECT_NEAR(r.dydt[3], -mu * f_n / M, 1e-14);
+  EXPECT_NEAR(r.dydt[4], 0.0, 1e-14);
+  EXPECT_NEAR(r.dydt[5], f_n / M - s.gravity, 1e-14);
+  EXPECT_NEAR(n * C * r.dydt[12], -mu * f_n * n * R * std::sin(th), 1e-13);
 }
 
 }  // namespace

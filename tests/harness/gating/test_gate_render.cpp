@@ -135,7 +135,7 @@ TEST(GateRender, JsonCounts) {
 }
 
 // The JSON result writes exactly the fields of CheckResult's and GateRow's field lists (gate.h),
-// and the committed schema (schemas/gate-result.schema.json, written by hand) describes each of
+// and the committed schema (schemas/gate-result.schema.json, generated from those lists) describes each of
 // them and no other: a field added to a list fails here until the schema has it.
 TEST(GateRender, JsonResultIsTheFieldListsAndTheSchemaDescribesThem) {
   const auto keys = [](const std::vector<FieldInfo>& fields) {
