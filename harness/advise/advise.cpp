@@ -9,6 +9,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "harness/advise/advice_record.h"
 #include "harness/gating/gate.h"
 #include "harness/io/files.h"
 #include "harness/io/scene_io.h"
@@ -372,6 +373,9 @@ AdviceResult run_advise(const AdviseOptions& o) {
     fs::remove(out / "advice.toml", ec);  // an earlier run's advice no longer holds
   }
 
+  // The record: what the page says, for a program (its fields: advice_record.h).
+  write_file_atomic((out / "advice.json").string(), to_json(advice_record(res)).dump(2) + "\n");
+
   // The page: one sentence per engine, the configurations, the evidence.
   Document doc;
   doc.title = "Advice for " + scene.name;
@@ -425,6 +429,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
                                 {"their records", "sweep/records.jsonl"}};
   if (!confirm.empty()) links.push_back({"the confirming runs", "confirm/records.jsonl"});
   if (res.gate_written) links.push_back({"the gate", "advice.toml"});
+  links.push_back({"the advice as a record", "advice.json"});
   doc.links(links);
   doc.para(std::to_string(res.runs) + " runs; the searches resume from OUT/sweep when run again, and run under MPI or in "
            "shards as `tippe sweep advise-sweep.toml --out sweep` does.");

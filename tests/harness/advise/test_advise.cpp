@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "harness/advise/advise.h"
+#include "harness/advise/advice_record.h"
 #include "harness/gating/gate_boundary.h"
 #include "engines/core/registry.h"
 #include "harness/report/sweep_analysis.h"
@@ -18,6 +19,7 @@
 
 namespace fs = std::filesystem;
 using namespace tippe;
+using nlohmann::json;
 
 namespace {
 
@@ -65,6 +67,19 @@ TEST(Advise, FindsTheBoundaryInLogRunsAndWritesAGateThatHolds) {
   const SearchCriterion c = parse_criterion("regime and inversion within 10%");
   EXPECT_TRUE(is_safe(c, confirm[0])) << unsafe_reason(c, confirm[0]);
   EXPECT_EQ(confirm[0].ladder_value, search_round(*b[0].boundary / kAdviceMargin));
+
+  // The record says what the page and the gate say.
+  const json advice = json::parse(slurp(out / "advice.json"));
+  EXPECT_EQ(advice.at("format"), kAdviceFormat);
+  ASSERT_EQ(advice.at("engines").size(), 1u);
+  const json& ode = advice.at("engines").at(0);
+  EXPECT_EQ(ode.at("engine"), "ode");
+  EXPECT_EQ(ode.at("advised_step").get<double>(), confirm[0].ladder_value);
+  EXPECT_EQ(ode.at("largest_safe_step").get<double>(), *b[0].boundary);
+  EXPECT_EQ(ode.at("settings").back(), "engines.ode.timestep=" + search_value_text(confirm[0].ladder_value));
+  EXPECT_EQ(ode.at("confirm_point"), confirm[0].point_id);
+  EXPECT_TRUE(ode.at("reason").is_null());
+  EXPECT_TRUE(advice.at("gate_written").get<bool>());
 
   // The gate passes as written ...
   const fs::path gate = out / "advice.toml";
@@ -212,3 +227,51 @@ TEST(OneCriterion, ParsesAndPrintsItsTerms) {
 }
 
 }  // namespace
+
+// advice.json writes exactly the fields of its two lists (advice_record.h), an engine without
+// advice with nulls where the advice would be and its reason.
+TEST(AdviceRecord, WritesExactlyItsListedFields) {
+  AdviceResult r;
+  r.scene_name = "toy";
+  r.criterion = "regime";
+  r.duration = 5;
+  r.runs = 12;
+  r.gate_written = true;
+  AdviceEngine chosen;
+  chosen.engine = "mujoco";
+  chosen.knob = "timestep";
+  chosen.configs.push_back({"mujoco", "mujoco-0", {"integrator"}, {"\"RK4\""}});
+  chosen.chosen = 0;
+  chosen.step = 2e-4;
+  chosen.boundary = 4e-4;
+  chosen.beyond = 0;  // safe to the end of the range
+  chosen.cpu_seconds = 0.5;
+  chosen.confirm_point = "p1";
+  AdviceEngine none;
+  none.engine = "ode";
+  none.knob = "timestep";
+  none.reason = "no configuration is safe in the searched range";
+  r.engines = {chosen, none};
+
+  const json j = to_json(advice_record(r));
+  std::set<std::string> keys, listed = {"format"};
+  for (const auto& [k, v] : j.items()) keys.insert(k);
+  for (const FieldInfo& f : field_list<AdviceRecord>()) listed.insert(f.key);
+  EXPECT_EQ(keys, listed);
+  std::set<std::string> engine_keys, engine_listed;
+  for (const auto& [k, v] : j.at("engines").at(0).items()) engine_keys.insert(k);
+  for (const FieldInfo& f : field_list<EngineAdvice>()) engine_listed.insert(f.key);
+  EXPECT_EQ(engine_keys, engine_listed);
+
+  const json& m = j.at("engines").at(0);
+  EXPECT_EQ(m.at("configuration"), "integrator = RK4");
+  EXPECT_EQ(m.at("settings"), json({"engines.mujoco.integrator=\"RK4\"", "engines.mujoco.timestep=0.0002"}));
+  EXPECT_EQ(m.at("advised_step"), 2e-4);
+  EXPECT_TRUE(m.at("first_unsafe_step").is_null());
+  EXPECT_TRUE(m.at("reason").is_null());
+  const json& o = j.at("engines").at(1);
+  EXPECT_TRUE(o.at("configuration").is_null());
+  EXPECT_TRUE(o.at("advised_step").is_null());
+  EXPECT_EQ(o.at("reason"), none.reason);
+  EXPECT_TRUE(j.at("reference_inversion_time").is_null());
+}
