@@ -2,10 +2,12 @@
 #pragma once
 
 #include <charconv>
-#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <system_error>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace tippe {
 
@@ -29,6 +31,23 @@ inline std::uint64_t digit_bytes8(std::uint32_t n) {
   const std::uint64_t t = ((v * 103U) >> 10) & 0x000F000F000F000FULL;
   return t | ((v - t * 10U) << 8);
 }
+
+#if defined(__SSE2__)
+// n < 10^8 as its 8 decimal digits in 16-bit lanes, the first in lane 0 (SSE2, part of x86-64):
+// n / 10^4 and n % 10^4 by a multiplication, each broadcast to four lanes and divided by 10^3,
+// 10^2, 10 and 1 by multiply-high with a reciprocal and a shift, then each quotient less ten
+// times its predecessor. Checked for every n.
+inline __m128i digit_lanes8(std::uint32_t n) {
+  const __m128i v = _mm_cvtsi32_si128(static_cast<int>(n));
+  const __m128i hi = _mm_srli_epi64(_mm_mul_epu32(v, _mm_set1_epi32(static_cast<int>(0xd1b71759U))), 45);
+  const __m128i lo = _mm_sub_epi32(v, _mm_mul_epu32(hi, _mm_set1_epi32(10000)));
+  const __m128i v1 = _mm_slli_epi64(_mm_unpacklo_epi16(hi, lo), 2);
+  const __m128i v2 = _mm_unpacklo_epi32(_mm_unpacklo_epi16(v1, v1), _mm_unpacklo_epi16(v1, v1));
+  const __m128i v3 = _mm_mulhi_epu16(v2, _mm_setr_epi16(8389, 5243, 13108, -32768, 8389, 5243, 13108, -32768));
+  const __m128i v4 = _mm_mulhi_epu16(v3, _mm_setr_epi16(1 << 7, 1 << 11, 1 << 13, -32768, 1 << 7, 1 << 11, 1 << 13, -32768));
+  return _mm_sub_epi16(v4, _mm_slli_epi64(_mm_mullo_epi16(v4, _mm_set1_epi16(10)), 16));
+}
+#endif
 
 #if defined(__SIZEOF_INT128__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
 __extension__ typedef unsigned __int128 u128;
@@ -102,14 +121,12 @@ inline constexpr PowerTable kPowers = make_power_table();
 // The index of a nonzero word's highest nonzero byte.
 inline int top_byte(std::uint64_t w) { return (63 - __builtin_clzll(w)) / 8; }
 
-// The 17 significant digits of a > 0 rounded to nearest, and the decimal exponent X of the
-// rounded value (a ~ N 10^(X-16), 10^16 <= N < 10^17); false where the fast path cannot vouch
-// for the rounding (see g17).
-inline bool digits17(double a, std::uint64_t& n, int& x) {
-  std::uint64_t bits;
-  std::memcpy(&bits, &a, sizeof bits);
+// The 17 significant digits of a > 0 (given by its bits) rounded to nearest, and the decimal
+// exponent X of the rounded value (a ~ N 10^(X-16), 10^16 <= N < 10^17); false where the fast
+// path cannot vouch for the rounding (see g17).
+inline bool digits17(std::uint64_t bits, std::uint64_t& n, int& x) {
   const int biased = static_cast<int>(bits >> 52) & 0x7ff;
-  if (biased == 0) return false;  // subnormal: to_chars
+  if (biased == 0 || biased == 0x7ff) return false;  // subnormal, infinite or NaN: to_chars
   // a = m 2^e, 2^52 <= m < 2^53; a lies in [2^(e2-1), 2^e2).
   const std::uint64_t m = (bits & ((std::uint64_t{1} << 52) - 1)) | (std::uint64_t{1} << 52);
   const int e = biased - 1075, e2 = biased - 1022;
@@ -120,12 +137,14 @@ inline bool digits17(double a, std::uint64_t& n, int& x) {
     const int k = 16 - x;
     if (k < kMinPower || k > kMaxPower) return false;
     const Power& pw = kPowers.p[k - kMinPower];
-    // a 10^k ~ m P 2^(e+q): the product's bits above its low 64, and the binary point r bits
-    // up from their bottom (56 <= r <= 63 for a 10^k in [1e16, 1e18)).
+    // a 10^k ~ m P 2^(e+q): the product's bits above its low 64 (hi:lo), and the binary point
+    // r bits up from their bottom: 56 <= r <= 63 for a 10^k in [1e16, 1e18) (m P is in
+    // [2^179, 2^181)), so the whole part is hi's low bits over lo's high ones.
     const u128 top = static_cast<u128>(m) * pw.hi + ((static_cast<u128>(m) * pw.lo) >> 64);
     const int r = -(e + pw.q) - 64;
-    if (r < 1 || r > 120) return false;  // not expected
-    const std::uint64_t whole = static_cast<std::uint64_t>(top >> r);
+    if (r < 56 || r > 63) return false;  // not expected
+    const auto hi = static_cast<std::uint64_t>(top >> 64), lo = static_cast<std::uint64_t>(top);
+    const std::uint64_t whole = (hi << (64 - r)) | (lo >> r);
     if (whole >= 100000000000000000ULL) {
       ++x;
       continue;
@@ -135,7 +154,7 @@ inline bool digits17(double a, std::uint64_t& n, int& x) {
     // dropped low bits, under 2^-r, and P's truncation, under a 10^k 2^-127). Away from a half
     // by more than that, the rounding to nearest of the exact product is that of this one; near
     // a half (a tie or close to one) it is left to to_chars.
-    const std::uint64_t frac = static_cast<std::uint64_t>((top << (128 - r)) >> 64);
+    const std::uint64_t frac = lo << (64 - r);
     constexpr std::uint64_t half = std::uint64_t{1} << 63, margin = std::uint64_t{1} << 12;
     if (frac >= half - margin && frac <= half + margin) return false;
     n = whole + (frac > half ? 1 : 0);
@@ -149,7 +168,7 @@ inline bool digits17(double a, std::uint64_t& n, int& x) {
 }
 #else
 // No 128-bit product (MSVC) or a big-endian machine: every number goes to to_chars.
-inline bool digits17(double, std::uint64_t&, int&) { return false; }
+inline bool digits17(std::uint64_t, std::uint64_t&, int&) { return false; }
 inline int top_byte(std::uint64_t w) {
   int b = 0;
   while (w >>= 8) ++b;
@@ -167,32 +186,43 @@ inline int top_byte(std::uint64_t w) {
 // number below 1e44 and zeros, and hands the rest, infinities and NaNs (and the few numbers
 // whose digits beyond the 17th are within 2^-52 of a rounding tie) to to_chars.
 inline char* g17(char* p, char* end, double v) {
-  if (v == 0.0) {  // "0" or "-0"
-    if (std::signbit(v)) *p++ = '-';
+  std::uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  const bool negative = (bits >> 63) != 0;
+  if ((bits << 1) == 0) {  // "0" or "-0"
+    if (negative) *p++ = '-';
     *p++ = '0';
     return p;
   }
-  const double a = std::fabs(v);
   std::uint64_t n = 0;
   int x = 0;
-  if (!(std::isfinite(v) && g17_detail::digits17(a, n, x)))
+  if (!g17_detail::digits17(bits & ~(std::uint64_t{1} << 63), n, x))
     return std::to_chars(p, end, v, std::chars_format::general, 17).ptr;
-  // The 17 digits: the first, then two words of 8 (one a byte, the first digit lowest).
+  // The 17 digits: the first, then the other 16 as text in `tail`; `last`, the last digit kept
+  // (%g drops trailing zeros), from the highest nonzero one.
   const std::uint64_t upper = n / 100000000U;  // 9 digits
   const char first = static_cast<char>('0' + upper / 100000000U);
-  const std::uint64_t b1 = g17_detail::digit_bytes8(static_cast<std::uint32_t>(upper % 100000000U));
-  const std::uint64_t b2 = g17_detail::digit_bytes8(static_cast<std::uint32_t>(n % 100000000U));
+  const auto mid8 = static_cast<std::uint32_t>(upper % 100000000U), low8 = static_cast<std::uint32_t>(n % 100000000U);
+  char tail[16];
+#if defined(__SSE2__)
+  const __m128i digits = _mm_packus_epi16(g17_detail::digit_lanes8(mid8), g17_detail::digit_lanes8(low8));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(tail), _mm_add_epi8(digits, _mm_set1_epi8('0')));
+  const unsigned nonzero = ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(digits, _mm_setzero_si128()))) & 0xffffU;
+  const int last = nonzero ? 1 + (31 - __builtin_clz(nonzero)) : 0;
+#else
+  const std::uint64_t b1 = g17_detail::digit_bytes8(mid8), b2 = g17_detail::digit_bytes8(low8);
   const std::uint64_t zeros = 0x3030303030303030ULL;  // '0' in every byte
   const std::uint64_t t1 = b1 | zeros, t2 = b2 | zeros;
-  // The last digit kept (%g drops trailing zeros): the highest nonzero digit byte.
+  std::memcpy(tail, &t1, 8);
+  std::memcpy(tail + 8, &t2, 8);
   const int last = b2 ? 9 + g17_detail::top_byte(b2) : b1 ? 1 + g17_detail::top_byte(b1) : 0;
+#endif
   // Each layout writes the 17 digits whole and moves p to the end of the digits kept.
-  if (std::signbit(v)) *p++ = '-';
+  if (negative) *p++ = '-';
   if (x < -4 || x >= 17) {  // d.ddde-XX
     p[0] = first;
     p[1] = '.';
-    std::memcpy(p + 2, &t1, 8);
-    std::memcpy(p + 10, &t2, 8);
+    std::memcpy(p + 2, tail, 16);
     p += last > 0 ? last + 2 : 1;
     *p++ = 'e';
     *p++ = x < 0 ? '-' : '+';
@@ -203,8 +233,7 @@ inline char* g17(char* p, char* end, double v) {
   } else if (x >= 0) {  // the digits up to x, '.', the rest
     char d[40];
     d[0] = first;
-    std::memcpy(d + 1, &t1, 8);
-    std::memcpy(d + 9, &t2, 8);
+    std::memcpy(d + 1, tail, 16);
     std::memset(d + 17, '0', 23);  // what the second block copy reads beyond the digits
     std::memcpy(p, d, 17);
     p[x + 1] = '.';
@@ -214,8 +243,7 @@ inline char* g17(char* p, char* end, double v) {
     std::memcpy(p, "0.000", 5);
     p += 1 - x;
     p[0] = first;
-    std::memcpy(p + 1, &t1, 8);
-    std::memcpy(p + 9, &t2, 8);
+    std::memcpy(p + 1, tail, 16);
     p += last + 1;
   }
   return p;

@@ -206,9 +206,17 @@ const std::vector<std::string>& trajectory_columns() {
 CsvTrajectoryWriter::CsvTrajectoryWriter(std::string path) : path_(std::move(path)), tmp_(temp_name(path_)) {
   f_ = std::fopen(tmp_.c_str(), "wb");
   if (!f_) throw OutputError(path_ + ": cannot write: " + errno_text());
+  // Rows are formatted into buffer_ in place and handed to the file a megabyte at a time: one
+  // fwrite per row cost as much again as a row's copy.
   buffer_.resize(1 << 20);
-  std::setvbuf(f_, buffer_.data(), _IOFBF, buffer_.size());
-  if (std::fputs(trajectory_csv_header().c_str(), f_) == EOF) fail("cannot write");
+  const std::string header = trajectory_csv_header();
+  std::memcpy(buffer_.data(), header.data(), header.size());
+  used_ = header.size();
+}
+
+void CsvTrajectoryWriter::flush_rows() {
+  if (used_ && std::fwrite(buffer_.data(), 1, used_, f_) != used_) fail("cannot write");
+  used_ = 0;
 }
 
 CsvTrajectoryWriter::~CsvTrajectoryWriter() {
@@ -309,9 +317,8 @@ std::string trajectory_csv_header() {
 
 void CsvTrajectoryWriter::write(const Observation& o) {
   if (!f_) throw std::logic_error(path_ + ": write after commit");
-  char line[kTrajectoryRowMax];
-  const size_t n = format_trajectory_row(o, line);
-  if (std::fwrite(line, 1, n, f_) != n) fail("cannot write");
+  if (buffer_.size() - used_ < kTrajectoryRowMax) flush_rows();
+  used_ += format_trajectory_row(o, buffer_.data() + used_);
 }
 
 CsvTrajectoryText::CsvTrajectoryText() : text(trajectory_csv_header()) {}
@@ -323,6 +330,7 @@ void CsvTrajectoryText::write(const Observation& o) {
 
 void CsvTrajectoryWriter::commit() {
   if (!f_) throw std::logic_error(path_ + ": commit twice");
+  flush_rows();
   if (std::fflush(f_) != 0) fail("cannot write");
   if (::fsync(::fileno(f_)) != 0) fail("cannot sync");
   const int rc = std::fclose(f_);
