@@ -291,21 +291,24 @@ size_t format_trajectory_row(const Observation& o, char* line) {
   char* p = line;
   char* const end = line + kTrajectoryRowMax;
   for (size_t i = 0; i < kTrajectoryColumns; ++i) {
-    if (i) *p++ = ',';
     begin[i] = static_cast<std::uint16_t>(p - line);
     const int t = twin[i];
-    if (i == surface_column) {
-      for (const char* s = to_string(o.surface); *s;) *p++ = *s++;
-    } else if (t >= 0 && std::memcmp(&values[i], &values[t], sizeof(double)) == 0) {
-      const size_t n = static_cast<size_t>(end_of[t] - begin[t]);
-      std::memcpy(p, line + begin[t], n);
-      p += n;
-    } else {
+    if (t >= 0 && std::memcmp(&values[i], &values[t], sizeof(double)) == 0) {
+      // A block the size of any number's text (24 chars at most), through a copy: the twin's
+      // text may end just before p.
+      char text[32];
+      std::memcpy(text, line + begin[t], sizeof text);
+      std::memcpy(p, text, sizeof text);
+      p += end_of[t] - begin[t];
+    } else if (i != surface_column) {
       p = g17(p, end, values[i]);  // std::to_chars(general, 17)'s bytes, faster
+    } else {
+      for (const char* s = to_string(o.surface); *s;) *p++ = *s++;
     }
     end_of[i] = static_cast<std::uint16_t>(p - line);
+    *p++ = ',';
   }
-  *p++ = '\n';
+  p[-1] = '\n';
   return static_cast<size_t>(p - line);
 }
 
