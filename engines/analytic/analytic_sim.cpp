@@ -54,9 +54,13 @@ class AnalyticSimulator final : public Simulator {
   void advance_to(double t) override { model_->advance_to(t); }
   Observation observe() const override {
     const BodyModel& b = model_->body();
-    Observation o = observe_kinematics(b, model_->state());
+    // The slip speed comes from the contact forces below, off the floor from the kinematics.
+    Observation o = observe_kinematics(b, model_->state(), /*slip=*/false);
     const Surface s = model_->contact_surface();
-    if (s == Surface::None) return o;
+    if (s == Surface::None) {
+      o.slip_speed = contact_slip_speed(b, o.state, o.surface);
+      return o;
+    }
     const ContactForces f = model_->forces();
     const Surface primary = s == Surface::Stem ? Surface::Stem : Surface::Ball;
     const int slot = primary == Surface::Stem ? 1 : 0;
