@@ -97,17 +97,21 @@ double tilt(const Quat& q_WB) {
 
 namespace {
 
+double slip_speed_at(const BodyState& x, const Vec3& R_C_W) {
+  const Vec3 w_W = x.q_WB * x.w_B;
+  const Vec3 v_C = x.v_WG + w_W.cross(R_C_W);
+  return std::hypot(v_C.x(), v_C.y());
+}
+
 // The observables of x with the contact quantities taken on surface `on`.
-Observation observe_on(const BodyModel& m, const BodyState& x, Surface on) {
+Observation observe_on(const BodyModel& m, const BodyState& x, Surface on, bool slip = true) {
   Observation o;
   o.state = x;
   o.theta = tilt(x.q_WB);
   o.surface = on;
   const Vec3 R_C_W = contact_offset_W(m, x.q_WB, on);
   o.p_WC = x.p_WG + R_C_W;
-  const Vec3 w_W = x.q_WB * x.w_B;
-  const Vec3 v_C = x.v_WG + w_W.cross(R_C_W);
-  o.slip_speed = std::hypot(v_C.x(), v_C.y());
+  if (slip) o.slip_speed = slip_speed_at(x, R_C_W);
   o.energy = energy(m, x);
   o.jellett = jellett(m, x, on);
   // Latitude of the ball point under O measured from the south pole -e_Z.
@@ -118,7 +122,13 @@ Observation observe_on(const BodyModel& m, const BodyState& x, Surface on) {
 
 }  // namespace
 
-Observation observe_kinematics(const BodyModel& m, const BodyState& x) { return observe_on(m, x, lower_surface(m, x.q_WB)); }
+Observation observe_kinematics(const BodyModel& m, const BodyState& x, bool slip) {
+  return observe_on(m, x, lower_surface(m, x.q_WB), slip);
+}
+
+double contact_slip_speed(const BodyModel& m, const BodyState& x, Surface s) {
+  return slip_speed_at(x, contact_offset_W(m, x.q_WB, s));
+}
 
 Observation observe_kinematics_on_both(const BodyModel& m, const BodyState& x) {
   Observation o = observe_on(m, x, Surface::Ball);

@@ -30,8 +30,12 @@ double energy(const BodyModel& m, const BodyState& x);
 double jellett(const BodyModel& m, const BodyState& x, Surface s);
 double tilt(const Quat& q_WB);
 // Fills every kinematic observable of x; force fields are left for the caller. The contact
-// quantities (point, slip, Jellett's J, surface) are those of the lower surface.
-Observation observe_kinematics(const BodyModel& m, const BodyState& x);
+// quantities (point, slip, Jellett's J, surface) are those of the lower surface. Without
+// `slip`, slip_speed is left at 0 (for a caller that takes it from its contact forces).
+Observation observe_kinematics(const BodyModel& m, const BodyState& x, bool slip = true);
+// The horizontal speed of the material point at surface s's contact point: observe_kinematics'
+// slip_speed.
+double contact_slip_speed(const BodyModel& m, const BodyState& x, Surface s);
 // The same with ball and stem on the floor together (surface Both), as the reference reports its
 // two-contact phase: the contact quantities are the ball's.
 Observation observe_kinematics_on_both(const BodyModel& m, const BodyState& x);

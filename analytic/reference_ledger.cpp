@@ -67,6 +67,8 @@ struct LagrangeTable {
   // Per node j, the coefficients (lowest first) of the antiderivative of its Lagrange
   // polynomial, divided by x: A_j(x) = x sum_k anti[j][k] x^k.
   std::array<std::array<double, N>, N> anti{};
+  // Per node, A_j(1): its coefficients summed highest first, once here instead of per call.
+  std::array<double, N> at_one{};
   explicit LagrangeTable(const double* xs) {
     for (int j = 0; j < N; ++j) {
       std::array<double, N> c{};
@@ -80,18 +82,16 @@ struct LagrangeTable {
         ++deg;
       }
       for (int k = 0; k < N; ++k) anti[j][k] = c[k] / (k + 1);
+      for (int k = N - 1; k >= 0; --k) at_one[j] += anti[j][k];
     }
   }
   // The work of the interpolant through values p[0..N) from x to 1, per unit half-length.
   Vec3 work_to_end(double x, const Vec3* p) const {
     Vec3 sum = Vec3::Zero();
     for (int j = 0; j < N; ++j) {
-      double at_x = 0.0, at_1 = 0.0;
-      for (int k = N - 1; k >= 0; --k) {
-        at_x = at_x * x + anti[j][k];
-        at_1 += anti[j][k];
-      }
-      sum += (at_1 - x * at_x) * p[j];
+      double at_x = 0.0;
+      for (int k = N - 1; k >= 0; --k) at_x = at_x * x + anti[j][k];
+      sum += (at_one[j] - x * at_x) * p[j];
     }
     return sum;
   }

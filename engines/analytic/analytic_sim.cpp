@@ -54,19 +54,27 @@ class AnalyticSimulator final : public Simulator {
   void advance_to(double t) override { model_->advance_to(t); }
   Observation observe() const override {
     const BodyModel& b = model_->body();
-    Observation o = observe_kinematics(b, model_->state());
+    // The slip speed comes from the contact forces below, off the floor from the kinematics.
+    Observation o = observe_kinematics(b, model_->state(), /*slip=*/false);
     const Surface s = model_->contact_surface();
-    if (s == Surface::None) return o;
+    if (s == Surface::None) {
+      o.slip_speed = contact_slip_speed(b, o.state, o.surface);
+      return o;
+    }
     const ContactForces f = model_->forces();
-    o.surface = s;
-    o.normal_force = f.normal[0] + f.normal[1];
     const Surface primary = s == Surface::Stem ? Surface::Stem : Surface::Ball;
     const int slot = primary == Surface::Stem ? 1 : 0;
-    o.p_WC = o.state.p_WG + contact_offset_W(b, o.state.q_WB, primary);
+    // observe_kinematics took the contact point and J on the lower surface: the same calls
+    // when that is the touching one (always for a body without a stem), so kept.
+    if (o.surface != primary) {
+      o.p_WC = o.state.p_WG + contact_offset_W(b, o.state.q_WB, primary);
+      o.jellett = jellett(b, o.state, primary);
+    }
+    o.surface = s;
+    o.normal_force = f.normal[0] + f.normal[1];
     o.engine_contact_valid = true;
     o.p_WC_engine = o.p_WC;
     o.slip_speed = f.slip_W[slot].norm();
-    o.jellett = jellett(b, o.state, primary);
     return o;
   }
   WorkCounters work() const override {

@@ -301,9 +301,11 @@ class CsvTrajectoryWriter : public SampleSink {
 
  private:
   void fail(const std::string& what);
+  void flush_rows();  // buffer_'s rows to the file
   std::string path_, tmp_;
   std::FILE* f_ = nullptr;
-  std::vector<char> buffer_;
+  std::vector<char> buffer_;  // the header and rows not yet handed to f_
+  size_t used_ = 0;
 };
 
 // The CSV text of a trajectory, kept in memory (a reference sent between processes).

@@ -31,9 +31,10 @@ TEST(G17, SpecialValuesAndLayouts) {
 }
 
 TEST(G17, RandomDoublesOfEveryExponent) {
-  // Uniform bit patterns (every exponent alike, most outside the fast path's range), then
-  // numbers of the trajectory's sizes (1e-40 .. 1e6, either sign: the ledger's small terms go
-  // far below 1e-11, the two-power path), then short decimals of the same sizes, 500,000 each.
+  // Uniform bit patterns (every exponent alike, infinities, NaNs and subnormals among them),
+  // then numbers of the trajectory's sizes (1e-40 .. 1e6, either sign: the ledger's small terms
+  // go far below 1e-11), then short decimals of the same sizes, then dyadic numbers with up to
+  // 53 significant bits (exact 17-digit ties among them, which go to to_chars), 500,000 each.
   std::mt19937_64 rng(29);
   int mismatches = 0;
   auto check = [&](double v) {
@@ -50,6 +51,8 @@ TEST(G17, RandomDoublesOfEveryExponent) {
   for (int i = 0; i < 500000; ++i) check((i % 2 ? -1 : 1) * mant(rng) * std::pow(10.0, exp10(rng)));
   std::uniform_int_distribution<std::int64_t> digits(1, 999999999);
   for (int i = 0; i < 500000; ++i) check(static_cast<double>(digits(rng)) * std::pow(10.0, exp10(rng)));
+  std::uniform_int_distribution<int> shift(0, 52), exp2(-150, 60);
+  for (int i = 0; i < 500000; ++i) check((i % 2 ? -1 : 1) * std::ldexp(static_cast<double>(rng() >> (11 + shift(rng))), exp2(rng)));
   EXPECT_EQ(mismatches, 0);
 }
 
