@@ -67,10 +67,11 @@ struct InitialSpec {
 };
 
 // The values RunSpec::energy_gain_rule may take, the default first (harness/measure/metrics.h's
-// EnergyGainRule, in this order): "total" (the rise of E itself) and "ledger" (the energy the
-// run's ledger says was created, not released from a contact's store).
+// EnergyGainRule, in this order): "stored" (the rise of E plus the elastic energy the engine's
+// contact law stores, where it gives one), "total" (the rise of E itself) and "ledger" (the energy
+// the run's ledger says was created, not released from a contact's store).
 inline const std::vector<std::string>& energy_gain_rule_names() {
-  static const std::vector<std::string> names = {"total", "ledger"};
+  static const std::vector<std::string> names = {"stored", "total", "ledger"};
   return names;
 }
 
@@ -87,7 +88,7 @@ struct RunSpec {
   // time on the two part (the reference's self-check, harness/measure/self_check.h); false skips it.
   bool self_check = true;
   // How the bench counts an energy rise in a dissipative scene (harness/measure/metrics.h,
-  // docs/energy-ledger.md): one of energy_gain_rule_names(), by default the first, "total"
+  // docs/energy-ledger.md): one of energy_gain_rule_names(), by default the first, "stored"
   // (kDefaultEnergyGainRule). A choice of the bench, not physics: it moves no run, only the class
   // and the gain metrics, and is named beside them (energy_gain_rule in every comparison and
   // sweep record).

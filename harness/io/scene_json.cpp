@@ -65,7 +65,9 @@ nlohmann::json scene_to_json(const Scene& s) {
   if (s.initial.orientation_given) out["initial"]["orientation"] = s.initial.orientation;
   if (s.initial.position[0] != 0.0 || s.initial.position[1] != 0.0) out["initial"]["position"] = s.initial.position;
   if (!s.notes.empty()) out["notes"] = s.notes;
-  if (s.run.energy_gain_rule != RunSpec{}.energy_gain_rule) out["run"]["energy_gain_rule"] = s.run.energy_gain_rule;
+  // Absent means "total", the one rule of the records written before the key existed; every
+  // other rule, the default "stored" too, is named.
+  if (s.run.energy_gain_rule != "total") out["run"]["energy_gain_rule"] = s.run.energy_gain_rule;
   return out;
 }
 

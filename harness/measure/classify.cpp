@@ -56,8 +56,11 @@ std::optional<Finding> first_energy_gain(const Scene& scene, const Trajectory& t
   const bool relative = tr.energy[0] != 0;
   const bool ledger = rule == EnergyGainRule::Ledger && !tr.numerical_energy.empty() &&
                       std::isfinite(tr.numerical_energy.back());
-  return Finding{g.time, std::string(ledger ? "energy created (by the ledger: not friction work, not released from the contact's store) rose by "
-                                            : "energy rose by ") +
+  const bool stored = rule == EnergyGainRule::Stored && tr.elastic_energy.size() == tr.size() && tr.size() &&
+                      std::isfinite(tr.elastic_energy[0]);
+  return Finding{g.time, std::string(ledger   ? "energy created (by the ledger: not friction work, not released from the contact's store) rose by "
+                                     : stored ? "energy with the contact's stored elastic energy rose by "
+                                              : "energy rose by ") +
                              g6(g.rise_at_first) + (relative ? " E0" : "") + " between t = " + g6(g.since) +
                              " (its lowest so far) and " + g6(g.time) + " in a dissipative scene (tolerance " +
                              g6(g.tolerance) + " E0 on the net rise: 1e-06 E0 and the energy of 1e-4 R of contact depth; energy_gain_rule = " +

@@ -111,6 +111,16 @@ EnergyGainRule energy_gain_rule(const Scene& scene) {
 }
 
 std::vector<double> energy_counted(const Trajectory& tr, EnergyGainRule rule) {
+  if (rule == EnergyGainRule::Stored) {
+    // E + U - U0 where the run has a store from its first sample on (a per-run property of the
+    // engine's contact law); a later sample without one (a divergence) counts E alone.
+    if (tr.elastic_energy.size() != tr.size() || !tr.size() || !std::isfinite(tr.elastic_energy[0])) return tr.energy;
+    std::vector<double> c(tr.energy);
+    const double u0 = tr.elastic_energy[0];
+    for (size_t k = 0; k < tr.size(); ++k)
+      if (std::isfinite(tr.elastic_energy[k])) c[k] += tr.elastic_energy[k] - u0;
+    return c;
+  }
   if (rule == EnergyGainRule::Total || tr.numerical_energy.size() != tr.size()) return tr.energy;
   std::vector<double> c(tr.size());
   const double e0 = tr.size() ? tr.energy[0] : 0.0;

@@ -108,8 +108,9 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Metrics>> visit(R& m, V&
     return r;
   }();
   v(Field("energy_gain_rule",
-          "how energy_gain_events and energy_max_gain counted energy (harness/measure/metrics.h): ledger (energy "
-          "created by the ledger's account) or total (E); absent in records written before it")
+          "how energy_gain_events and energy_max_gain counted energy (harness/measure/metrics.h): stored (E with the "
+          "contact's stored elastic energy where the engine gives it), total (E) or ledger (energy created by the "
+          "ledger's account); absent in records written before it")
         .since()
         .one_of(rules),
     m.energy_gain_rule);

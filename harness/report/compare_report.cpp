@@ -279,10 +279,15 @@ std::vector<std::string> report_findings(const json& c) {
                       "); the reference has one at t = " + fmt(num(ref, time_key.c_str()), "%.6g"));
     }
     const long long gains = m.value("energy_gain_events", 0LL);
-    const std::string ledger = to_string(EnergyGainRule::Ledger);
+    const std::string ledger = to_string(EnergyGainRule::Ledger), stored = to_string(EnergyGainRule::Stored);
+    const std::string rule = str(m, "energy_gain_rule");
+    // Under the stored rule an engine whose contact stores no energy it reports counts E alone.
+    const bool with_store = rule == stored && m.contains("elastic_energy_max") && m["elastic_energy_max"].is_number();
     if (gains > 0)
       out.push_back(engine + ": energy " +
-                    (str(m, "energy_gain_rule") == ledger ? "created (energy_gain_rule = " + ledger + ") " : std::string()) +
+                    (rule == ledger       ? "created (energy_gain_rule = " + ledger + ") "
+                     : with_store ? "with its contact's stored elastic energy (energy_gain_rule = " + stored + ") "
+                                  : std::string()) +
                     "rose above its lowest earlier value " + std::to_string(gains) + " time" +
                     (gains == 1 ? "" : "s") + " by more than " + fmt(kEnergyGainTolerance, "%g") +
                     " E0 and the energy of 1e-4 R of contact depth (largest net rise " + fmt(num(m, "energy_max_gain"), "%.3g") +

@@ -201,6 +201,13 @@ Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<O
       if (got != static_cast<long long>(want))
         throw SweepInputError(where + key + ": " + std::to_string(got) + " is not point " + r.point_id + "'s (" +
                               std::to_string(want) + " in the plan); give --restart to begin the directory again");
+    // Its class counted gains by the rule the point's scene asks for: a record from a build with
+    // another default rule would mix two meanings of "unphysical" on one page.
+    const std::string& rule = r.metrics.energy_gain_rule;
+    if (!rule.empty() && rule != p.scene.run.energy_gain_rule)
+      throw SweepInputError(where + "metrics.energy_gain_rule: \"" + utf8_replaced(rule) + "\" is not point " + r.point_id +
+                            "'s (\"" + p.scene.run.energy_gain_rule +
+                            "\"); its class counted energy gains by another rule; give --restart to begin the directory again");
   }
   std::set<std::string> done;
   size_t duplicates = 0;

@@ -126,7 +126,7 @@ std::vector<Case> cases() {
        {": run.method: must be \"bulirsch_stoer\", \"dopri5\" or \"rosenbrock4\", got \"euler\""}},
       {"method_not_a_string", edit(b, "atol = 1e-12", "atol = 1e-12\nmethod = 4"), {}, {": run.method: expected a string"}},
       {"energy_gain_rule_unknown", edit(b, "sample_interval = 0.01", "sample_interval = 0.01\nenergy_gain_rule = \"net\""), {},
-       {": run.energy_gain_rule: must be \"total\" or \"ledger\", got \"net\""}},
+       {": run.energy_gain_rule: must be \"stored\" or \"total\" or \"ledger\", got \"net\""}},
       {"energy_gain_rule_not_a_string", edit(b, "sample_interval = 0.01", "sample_interval = 0.01\nenergy_gain_rule = 1"), {},
        {": run.energy_gain_rule: expected a string"}},
       {"atol_out_of_range", edit(b, "atol = 1e-12", "atol = 2"), {}, {": run.atol: 2 is out of range (expected 0 < atol <= 1)"}},

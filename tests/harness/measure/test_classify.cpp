@@ -11,21 +11,10 @@
 #include "harness/measure/run.h"
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
+#include "tests/support/classify_fixtures.h"
 
 namespace tippe {
 namespace {
-
-// A viscous top: energy must not rise, J must hold.
-Scene viscous_scene() {
-  Scene s;
-  s.name = "synthetic";
-  s.body.sphere_radius = 1.0;
-  s.contact.friction = FrictionLaw::Viscous;
-  s.contact.k = 1.0;
-  s.run.duration = 1.0;
-  s.run.sample_interval = 0.1;
-  return s;
-}
 
 // Samples at t = 0, 0.1, ...: E falls slowly from 10, J = -2, tilt grows, on the ball.
 struct Samples {
@@ -55,13 +44,6 @@ struct Samples {
   }
 };
 
-RunRecord ok_run() {
-  RunRecord r;
-  r.engine = "fake";
-  r.status = "ok";
-  return r;
-}
-
 // The record a run of these samples leaves: its summary numbers (Jellett drift per surface)
 // come from SampleSummary, told about the switch events between samples as run_simulator does.
 RunRecord summarized(const Samples& x, const std::vector<Event>& events = {}) {
@@ -84,12 +66,6 @@ RunRecord summarized(const Samples& x, const std::vector<Event>& events = {}) {
 
 RunClass classify(const Scene& s, const RunRecord& r, const Samples& x, const Metrics* m = nullptr) {
   return classify_run(s, r, m, x.trajectory());
-}
-
-void expect_ok(const RunClass& c) {
-  EXPECT_EQ(c.kind, RunClassKind::Ok) << c.reason;
-  EXPECT_TRUE(std::isnan(c.time));
-  EXPECT_TRUE(c.reason.empty()) << c.reason;
 }
 
 TEST(Classify, CleanDissipativeRunIsOk) {
@@ -155,73 +131,6 @@ TEST(Classify, TheEnergyRuleDoesNotDependOnTheSampleInterval) {
   EXPECT_NEAR(gc.time, 0.1, 1e-12) << "the coarse samples date it at their first";
   for (const Trajectory* tr : {&coarse, &fine})
     EXPECT_EQ(classify_run(viscous_scene(), ok_run(), nullptr, *tr).kind, RunClassKind::Unphysical);
-}
-
-// A run whose E rises by 1e-3 E0 over t = 0.5 .. 1.0 while its ledger books `booked` of it
-// (normal work with the contact's elastic energy falling by as much, or nothing).
-Trajectory ledger_trajectory(bool with_store, double booked) {
-  Trajectory tr;
-  for (int k = 0; k <= 10; ++k) {
-    Observation o;
-    o.state.t = 0.1 * k;
-    const double rise = k > 5 ? 1e-3 * 10.0 * (k - 5) / 5.0 : 0.0;
-    o.energy = 10.0 + rise;
-    o.surface = Surface::Ball;
-    o.normal_work = booked * rise;
-    o.friction_work = 0.0;
-    o.elastic_energy = with_store ? 0.02 - booked * rise : std::nan("");
-    o.numerical_energy = o.energy - 10.0 - o.normal_work;
-    tr.append(o);
-  }
-  return tr;
-}
-
-TEST(Classify, LedgerRuleDoesNotCountEnergyReleasedFromTheContactsStore) {
-  // The rise is the soft contact giving back what it stored (normal work = -dU): energy moved,
-  // none created. Under the ledger rule no gain; under the total rule the same run gains.
-  const Trajectory tr = ledger_trajectory(true, 1.0);
-  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Ledger).events, 0);
-  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Total).events, 1);
-}
-
-TEST(Classify, LedgerRuleCountsEnergyTheLedgerCannotExplain) {
-  // The same rise with nothing booked: numerical energy, created by the integrator; a gain under
-  // both rules, and the class says which rule counted it.
-  const Trajectory tr = ledger_trajectory(true, 0.0);
-  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Ledger).events, 1);
-  EXPECT_NEAR(energy_gains(tr, 0.0, EnergyGainRule::Ledger).max_rise, 1e-3, 1e-12);
-  const RunClass c = classify_run(viscous_scene(), ok_run(), nullptr, tr);
-  EXPECT_EQ(c.kind, RunClassKind::Unphysical);
-  EXPECT_NE(c.reason.find(std::string("energy_gain_rule = ") + to_string(kDefaultEnergyGainRule)), std::string::npos)
-      << c.reason;
-}
-
-TEST(Classify, TheScenesRunTableChoosesTheRule) {
-  // run.energy_gain_rule picks the rule the class counts with: the store's release is a gain
-  // under "total" (the default, kDefaultEnergyGainRule) and not under "ledger"; the reason names
-  // the rule that counted it.
-  const Trajectory tr = ledger_trajectory(true, 1.0);
-  Scene total = viscous_scene();
-  EXPECT_EQ(total.run.energy_gain_rule, to_string(kDefaultEnergyGainRule)) << "the scene's default is the constant";
-  const RunClass c = classify_run(total, ok_run(), nullptr, tr);
-  EXPECT_EQ(c.kind, RunClassKind::Unphysical);
-  EXPECT_NE(c.reason.find("energy_gain_rule = total"), std::string::npos) << c.reason;
-  Scene ledger = viscous_scene();
-  ledger.run.energy_gain_rule = "ledger";
-  EXPECT_EQ(energy_gain_rule(ledger), EnergyGainRule::Ledger);
-  expect_ok(classify_run(ledger, ok_run(), nullptr, tr));
-  // Energy the ledger cannot explain is a gain under both, named as the ledger's.
-  const RunClass created = classify_run(ledger, ok_run(), nullptr, ledger_trajectory(true, 0.0));
-  EXPECT_EQ(created.kind, RunClassKind::Unphysical);
-  EXPECT_NE(created.reason.find("energy_gain_rule = ledger"), std::string::npos) << created.reason;
-}
-
-TEST(Classify, LedgerRuleWithoutTheElasticEnergyCountsNormalWorkAsExchange) {
-  // Where the engine's contact law gives no elastic energy (n/a), the normal force's work is
-  // counted as an exchange with the contact's store: the rise it explains is not a gain.
-  const Trajectory tr = ledger_trajectory(false, 1.0);
-  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Ledger).events, 0);
-  EXPECT_EQ(energy_gains(tr, 0.0, EnergyGainRule::Total).events, 1);
 }
 
 TEST(Classify, JitterBelowTheToleranceNeverAddsUp) {

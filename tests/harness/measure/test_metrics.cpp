@@ -228,8 +228,13 @@ TEST(Metrics, PhysicsHashIgnoresNamesAndEngineSettings) {
   b.engines["ode"]["timestep"] = 1e-5;
   b.run.energy_gain_rule = "ledger";  // how a gain is counted moves no run: the cached reference serves both
   EXPECT_EQ(physics_hash(b), h);
-  EXPECT_EQ(scene_to_json(b).at("run").at("energy_gain_rule"), "ledger") << "named in the record when not the default";
-  EXPECT_FALSE(scene_to_json(a).at("run").contains("energy_gain_rule")) << "the default keeps every record as it was";
+  EXPECT_EQ(scene_to_json(b).at("run").at("energy_gain_rule"), "ledger") << "every rule but total is named in the record";
+  EXPECT_EQ(scene_to_json(a).at("run").at("energy_gain_rule"), "stored") << "the default too: absent meant total";
+  Scene t = a;
+  t.run.energy_gain_rule = "total";
+  EXPECT_FALSE(scene_to_json(t).at("run").contains("energy_gain_rule"))
+      << "total keeps the JSON of the records written before the key existed";
+  EXPECT_EQ(physics_hash(t), h);
   b.contact.k = 1.5;
   EXPECT_NE(physics_hash(b), h);
   Scene c = a;

@@ -1,4 +1,4 @@
-// Tests of running `tippe sweep` (harness/sweep/sweep_run.cpp): a killed sweep resumed to the same records, a changed sweep file refused unless restarted, and invalid input exiting 2 with nothing written (the analysis: tests/harness/report/test_sweep_analysis.cpp).
+// Tests of running `tippe sweep` (harness/sweep/sweep_run.cpp): a killed sweep resumed to the same records, a changed sweep file or records counted by another energy-gain rule refused unless restarted, and invalid input exiting 2 with nothing written (the analysis: tests/harness/report/test_sweep_analysis.cpp).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -148,6 +148,35 @@ TEST(SweepCli, ChangedSweepFileIsRefusedUnlessRestarted) {
   ASSERT_EQ(e.code, 0) << slurp(err);
   EXPECT_EQ(slurp(out / "records.jsonl.old"), first_old) << "--restart keeps every earlier record file";
   EXPECT_EQ(count_lines(out / "records.jsonl.old.2"), 2u);
+}
+
+TEST(SweepCli, RecordsCountedByAnotherEnergyGainRuleAreRefusedUnlessRestarted) {
+  // Records left by a build whose default rule counted gains another way (the rule before
+  // "stored" was "total"): resuming would put two meanings of "unphysical" on one page.
+  TempDir dir{"tippe-sweep"};
+  const fs::path out = dir.path() / "out", err = dir.path() / "err.txt";
+  const fs::path sweep = write_sweep(dir.path(), kGoodHead + kGoodSetup);
+  ChildExit e = run_tippe({"sweep", sweep.string(), "--out", out.string(), "--no-plots"}, err);
+  ASSERT_EQ(e.code, 0) << slurp(err);
+  std::string edited;
+  {
+    std::ifstream in(out / "records.jsonl");
+    for (std::string line; std::getline(in, line);) {
+      json r = json::parse(line);
+      ASSERT_EQ(r.at("metrics").at("energy_gain_rule"), "stored") << "the default rule is named in each record";
+      r["metrics"]["energy_gain_rule"] = "total";
+      edited += r.dump() + "\n";
+    }
+  }
+  std::ofstream(out / "records.jsonl", std::ios::trunc) << edited;
+  e = run_tippe({"sweep", sweep.string(), "--out", out.string(), "--no-plots"}, err);
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(slurp(err).find("records.jsonl:1: metrics.energy_gain_rule: \"total\" is not point"), std::string::npos)
+      << slurp(err);
+  EXPECT_EQ(slurp(out / "records.jsonl"), edited) << "nothing written";
+  e = run_tippe({"sweep", sweep.string(), "--out", out.string(), "--restart", "--no-plots"}, err);
+  ASSERT_EQ(e.code, 0) << slurp(err);
+  EXPECT_EQ(slurp(out / "records.jsonl.old"), edited) << "the refused records are kept aside";
 }
 
 TEST(SweepCli, InvalidSweepExitsWithTwoAndWritesNothing) {
