@@ -397,8 +397,11 @@ AdviceResult run_advise(const AdviseOptions& o) {
     if (!e.unsearched.empty()) t += " " + std::to_string(e.unsearched.size()) + " configuration(s) not searched (--max-runs).";
     doc.para(t, "verdict");
   }
+  const EnergyGainRule rule = energy_gain_rule(scene);
   doc.para(std::string("Safe: the run finished, the stability map classes it ok (no divergence, no net energy gain "
-                       "above 1e-6 E0 and the energy of 1e-4 R of contact depth in a dissipative scene, no Jellett drift where J is conserved), and ") +
+                       "above 1e-6 E0 and the energy of 1e-4 R of contact depth in a dissipative scene, counting ") +
+           energy_counted_text(rule) + " (energy_gain_rule = " + to_string(rule) +
+           "), no Jellett drift where J is conserved), and " +
            res.criterion + ". The advised " + "step is the largest safe step found / " + sig3(kAdviceMargin) +
            ", confirmed by a run there. " +
            (res.gate_written ? "advice.toml is the gate that keeps it: `tippe gate advice.toml`."

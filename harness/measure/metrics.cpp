@@ -103,6 +103,18 @@ double contact_energy_allowance(const Scene& scene) {
 
 const char* to_string(EnergyGainRule r) { return energy_gain_rule_names().at(static_cast<size_t>(r)).c_str(); }
 
+std::string energy_counted_text(EnergyGainRule r) {
+  switch (r) {
+    case EnergyGainRule::Stored:
+      return "E plus the elastic energy the contact stores where the engine's contact law gives it";
+    case EnergyGainRule::Total:
+      return "E itself";
+    case EnergyGainRule::Ledger:
+      return "the energy the run's ledger says was created";
+  }
+  return "E itself";
+}
+
 EnergyGainRule energy_gain_rule(const Scene& scene) {
   // A name the scene reader did not check (a scene built in code) counts as the default.
   const std::vector<std::string>& names = energy_gain_rule_names();

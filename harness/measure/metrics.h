@@ -3,6 +3,7 @@
 
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 #include "harness/records/comparison.h"
 #include "harness/records/trajectory.h"
@@ -91,6 +92,8 @@ struct EnergyGains {
 enum class EnergyGainRule { Stored, Total, Ledger };
 const char* to_string(EnergyGainRule r);
 inline constexpr EnergyGainRule kDefaultEnergyGainRule = EnergyGainRule::Stored;
+// What the rule counts, in words for a page ("E plus the elastic energy ...").
+std::string energy_counted_text(EnergyGainRule r);
 // The rule a scene asks for (run.energy_gain_rule, validated when the scene was read; its default
 // "stored" is kDefaultEnergyGainRule).
 EnergyGainRule energy_gain_rule(const Scene& scene);

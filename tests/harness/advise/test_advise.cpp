@@ -51,6 +51,11 @@ TEST(Advise, FindsTheBoundaryInLogRunsAndWritesAGateThatHolds) {
   ASSERT_TRUE(fs::exists(out / "index.html"));
   const std::string md = slurp(out / "index.md");
   EXPECT_EQ(md.find("ode: stepper = step"), md.find("ode: ")) << "the page opens with the engine's sentence\n" << md;
+  // The page states its one "safe" once, with the energy the gain rule counts (the scene's default).
+  EXPECT_NE(md.find("counting E plus the elastic energy the contact stores where the engine's contact law gives it "
+                    "(energy_gain_rule = stored)"),
+            std::string::npos)
+      << md;
 
   const std::vector<SweepRecord> records = read_records((out / "sweep" / "records.jsonl").string()).records;
   const std::vector<SearchBoundary> b = search_boundaries(records);
