@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "engines/core/registry.h"
+#include "harness/measure/metrics.h"
 #include "harness/records/records.h"
 #include "harness/report/sweep_analysis.h"
 #include "harness/report/sweep_groups.h"
@@ -338,6 +339,21 @@ std::vector<ChoiceEffect> modelling_choices(const std::vector<SweepRecord>& reco
       out.push_back(e);
     }
   return out;
+}
+
+std::string energy_gain_rules_text(const std::vector<SweepRecord>& records) {
+  std::set<std::string> rules;
+  for (const SweepRecord& r : records) rules.insert(r.metrics.energy_gain_rule.empty() ? "total" : r.metrics.energy_gain_rule);
+  const std::vector<std::string>& names = energy_gain_rule_names();
+  if (rules.size() == 1) {
+    const auto it = std::find(names.begin(), names.end(), *rules.begin());
+    if (it != names.end())
+      return "counting " + energy_counted_text(static_cast<EnergyGainRule>(it - names.begin())) +
+             " (energy_gain_rule = " + *it + ")";
+  }
+  std::string t;
+  for (const std::string& n : rules) t += (t.empty() ? "" : ", ") + n;
+  return "counting energy by each record's energy_gain_rule (" + t + ")";
 }
 
 }  // namespace tippe

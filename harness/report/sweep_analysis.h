@@ -81,6 +81,11 @@ struct ChoiceEffect {
 std::vector<ChoiceEffect> modelling_choices(const std::vector<SweepRecord>& records);
 
 // report.md, index.html and (when `plots`) the SVGs, into dir, from the records alone.
+// How the records' classes counted an energy gain, for the page's statement of "safe": the
+// energy counted and its energy_gain_rule when they share one, else each rule named (records
+// written before the rule was named counted E itself).
+std::string energy_gain_rules_text(const std::vector<SweepRecord>& records);
+
 void write_sweep_report(const std::string& dir, const std::vector<SweepRecord>& records, bool plots);
 std::string render_sweep_markdown(const std::vector<SweepRecord>& records);
 

@@ -349,8 +349,10 @@ Document build_doc(const std::vector<SweepRecord>& records, const std::vector<st
   const std::vector<std::string> verdicts = sweep_verdicts(scenes);
   for (const std::string& v : verdicts) doc.para(v, "verdict");
   if (!verdicts.empty())
-    doc.para("Safe, the one criterion of this page's sentences, its tables, its boundary searches and the gates: "
-             "the run finished (status ok), the stability map classes it ok, and it is in the reference's regime "
+    doc.para(std::string("Safe, the one criterion of this page's sentences, its tables, its boundary searches and the gates: ") +
+             "the run finished (status ok), the stability map classes it ok (no divergence, no net energy gain in "
+             "a dissipative scene " + energy_gain_rules_text(records) +
+             ", no Jellett drift where J is conserved), and it is in the reference's regime "
              "(it inverts where the reference does and finishes without inverting where it does not, judged inside "
              "the reference's converged window); where the reference inverts, the setting to use also has its "
              "inversion time within 1 % (10 % when no point is). Points the stability map classes "

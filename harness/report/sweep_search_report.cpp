@@ -6,6 +6,7 @@
 #include <set>
 #include <tuple>
 
+#include "harness/report/sweep_analysis.h"
 #include "harness/sweep/sweep_search.h"
 
 namespace tippe {
@@ -57,7 +58,9 @@ std::vector<ReportPart> boundary_report(const std::vector<SweepRecord>& records)
       "a criterion that changes more than once on the coarse grid is marked not monotonic, every crossing is "
       "listed, and the boundary given is the first from the fine end. A point is safe (the one criterion of "
       "the page's opening sentence, its regime table and the gates) when the run finished (status ok), the "
-      "stability map classes it ok (no divergence, no energy gain in a dissipative scene, no Jellett drift where "
+      "stability map classes it ok (no divergence, no net energy gain in a dissipative scene " +
+      energy_gain_rules_text(records) +
+      ", no Jellett drift where "
       "J is conserved), and every term of the criterion holds: \"regime\": it inverts when the reference does "
       "and does not when it does not, within the reference's converged window; \"inversion within TOL\": "
       "where the reference inverts, |relative inversion-time error| <= TOL; \"METRIC <= BOUND\": |METRIC| <= "

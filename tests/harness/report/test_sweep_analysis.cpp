@@ -280,3 +280,23 @@ TEST(SweepLadders, ModellingChoicesFindWhatMovesTheVerdict) {
   plain[0].scene = "s";
   EXPECT_EQ(render_sweep_markdown(plain).find("Modelling choices"), std::string::npos);
 }
+
+TEST(SweepAnalysis, ThePageNamesTheEnergyItsGainRuleCounted) {
+  // The page's one "safe" says how its records counted a gain: the one rule they share, with the
+  // energy it counts; every rule when they differ; records from before the rule was named, total.
+  std::vector<SweepRecord> rs = {point("ode", "ode", 1e-3, 1, 0.01), point("ode", "ode", 1e-4, 1, 0.01)};
+  for (SweepRecord& r : rs) r.metrics.energy_gain_rule = "stored";
+  EXPECT_EQ(energy_gain_rules_text(rs),
+            "counting E plus the elastic energy the contact stores where the engine's contact law gives it "
+            "(energy_gain_rule = stored)");
+  rs[1].metrics.energy_gain_rule = "ledger";
+  EXPECT_EQ(energy_gain_rules_text(rs), "counting energy by each record's energy_gain_rule (ledger, stored)");
+  rs[0].metrics.energy_gain_rule.clear();
+  rs[1].metrics.energy_gain_rule.clear();
+  EXPECT_EQ(energy_gain_rules_text(rs), "counting E itself (energy_gain_rule = total)");
+  for (SweepRecord& r : rs) {
+    r.scene = "s";
+    r.metrics.energy_gain_rule = "stored";
+  }
+  EXPECT_NE(render_sweep_markdown(rs).find("(energy_gain_rule = stored)"), std::string::npos) << render_sweep_markdown(rs);
+}
