@@ -9,7 +9,7 @@ namespace tippe {
 
 // What the module gives tippe (harness/sweep/mpi_session.cpp opens it when a launcher started the
 // process): a process that no launcher started, a reference run for one, never maps libmpi and its
-// half a dozen libraries, which cost the loader about as much as the rest of tippe's libraries.
+// seven libraries, which cost the loader about as much as the rest of tippe's libraries.
 struct MpiModule {
   void (*init)(int* rank, int* size);          // MPI_Init unless done; errors as codes; rank and world size
   void (*finalize)();                          // MPI_Finalize unless done
