@@ -1,6 +1,7 @@
 // The MPI session and farm through the MPI module, opened when a launcher started the process: no other tippe maps libmpi.
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -16,18 +17,21 @@ namespace tippe {
 namespace {
 
 // lib/tippe/ beside libtippe_runtime.so (the build tree and an installed tree), found from the
-// loader as the registry finds the engines' modules; beside a program that links the runtime
-// statically (TIPPE_ENGINE_MODULES=OFF), its lib/tippe/ and ../lib/tippe/.
+// loader as the registry finds the engines' modules; for a program that links the runtime
+// statically (TIPPE_ENGINE_MODULES=OFF), lib/tippe/ and ../lib/tippe/ beside the program.
 std::vector<std::filesystem::path> mpi_module_candidates() {
-  std::vector<std::filesystem::path> dirs;
-  Dl_info info{};
-  if (dladdr(reinterpret_cast<const void*>(&engine_module_dirs), &info) == 0 || !info.dli_fname) return dirs;
+  std::vector<std::filesystem::path> paths;
   std::error_code ec;
-  std::filesystem::path own = std::filesystem::canonical(info.dli_fname, ec);
-  own = (ec ? std::filesystem::path(info.dli_fname) : own).parent_path();
-  for (const auto& dir : {own / "tippe", own / "lib" / "tippe", own.parent_path() / "lib" / "tippe"})
-    dirs.push_back(dir / kMpiModuleFile);
-  return dirs;
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<const void*>(&engine_module_dirs), &info) != 0 && info.dli_fname) {
+    const std::filesystem::path lib = std::filesystem::canonical(info.dli_fname, ec);
+    if (!ec) paths.push_back(lib.parent_path() / "tippe" / kMpiModuleFile);
+  }
+  const std::filesystem::path exe = std::filesystem::canonical("/proc/self/exe", ec);
+  if (!ec)
+    for (const auto& dir : {exe.parent_path() / "lib" / "tippe", exe.parent_path().parent_path() / "lib" / "tippe"})
+      if (std::find(paths.begin(), paths.end(), dir / kMpiModuleFile) == paths.end()) paths.push_back(dir / kMpiModuleFile);
+  return paths;
 }
 
 // RTLD_GLOBAL: Open MPI opens its own components, which take libmpi's symbols from the global
