@@ -43,6 +43,10 @@ install(TARGETS ${TIPPE_LIBRARY_TARGETS} EXPORT tippeTargets
 if(TARGET tippe)
   install(TARGETS tippe RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endif()
+if(TARGET tippe_mpi)
+  # Opened by tippe under an MPI launcher, from lib/tippe/ beside the runtime (harness/sweep/mpi_session.cpp).
+  install(TARGETS tippe_mpi LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/tippe)
+endif()
 # Engines as modules (TIPPE_ENGINE_MODULES): the shared runtime in lib/, each module in
 # lib/tippe/engines/ (where the registry looks, beside the runtime), and the programs that load
 # them find the runtime from their own place.

@@ -8,6 +8,7 @@
 #include <istream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -304,8 +305,8 @@ class CsvTrajectoryWriter : public SampleSink {
   void flush_rows();  // buffer_'s rows to the file
   std::string path_, tmp_;
   std::FILE* f_ = nullptr;
-  std::vector<char> buffer_;  // the header and rows not yet handed to f_
-  size_t used_ = 0;
+  std::unique_ptr<char[]> buffer_;  // the header and rows not yet handed to f_ (not zeroed)
+  size_t capacity_ = 0, used_ = 0;
 };
 
 // The CSV text of a trajectory, kept in memory (a reference sent between processes).

@@ -1,5 +1,5 @@
-// Tasks over MPI ranks: rank 0 hands out task indices one at a time as workers ask, and receives every result.
-#include "harness/sweep/mpi_farm.h"
+// Tasks over MPI ranks (the MPI module): rank 0 hands out task indices one at a time as workers ask, and receives every result.
+#include "harness/sweep/mpi_module.h"
 
 #include <mpi.h>
 
@@ -101,7 +101,7 @@ int64_t index_of(const std::string& m) {
 
 class MpiFarm : public TaskFarm {
  public:
-  explicit MpiFarm(const MpiSession& s) : rank_(s.rank()), size_(s.size()) {}
+  MpiFarm(int rank, int size) : rank_(rank), size_(size) {}
   bool coordinator() const override { return rank_ == 0; }
   int workers() const override { return size_ - 1; }
   bool distributed() const override { return size_ > 1; }
@@ -221,27 +221,25 @@ class MpiFarm : public TaskFarm {
   int rank_, size_;
 };
 
-}  // namespace
-
-MpiSession::MpiSession() {
+void init(int* rank, int* size) {
   int initialized = 0;
   MPI_Initialized(&initialized);
   if (!initialized) check(MPI_Init(nullptr, nullptr), "init");
   // Errors come back as codes (turned into exceptions) instead of aborting the job.
   MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  MPI_Comm_rank(MPI_COMM_WORLD, rank);
+  MPI_Comm_size(MPI_COMM_WORLD, size);
 }
 
-MpiSession::~MpiSession() {
+void finalize() {
   int finalized = 0;
   MPI_Finalized(&finalized);
   if (!finalized) MPI_Finalize();
 }
 
-std::unique_ptr<TaskFarm> make_mpi_farm(const MpiSession& session) { return std::make_unique<MpiFarm>(session); }
+TaskFarm* make_farm(int rank, int size) { return new MpiFarm(rank, size); }
 
-std::string mpi_library_version() {
+std::string library_version() {
   char text[MPI_MAX_LIBRARY_VERSION_STRING];
   int len = 0;
   MPI_Get_library_version(text, &len);
@@ -250,4 +248,11 @@ std::string mpi_library_version() {
   return cut == std::string::npos ? v : v.substr(0, cut);
 }
 
+}  // namespace
+
 }  // namespace tippe
+
+extern "C" const tippe::MpiModule* tippe_mpi_module() {
+  static const tippe::MpiModule module{tippe::init, tippe::finalize, tippe::make_farm, tippe::library_version};
+  return &module;
+}

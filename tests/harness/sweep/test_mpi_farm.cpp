@@ -1,4 +1,4 @@
-// Tests of sweeps over MPI ranks (harness/sweep/mpi_farm.cpp): mpirun -np 2 and 3, grids, shards, a job killed and resumed, bad input and failing references giving a local run's records; a build without MPI refuses to run as one of many ranks.
+// Tests of sweeps over MPI ranks (harness/sweep/mpi_farm.cpp): mpirun -np 2 and 3, grids, shards, a job killed and resumed, bad input and failing references giving a local run's records; a build without MPI refuses to run as one of many ranks; only the MPI module maps libmpi.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -189,6 +189,21 @@ TEST(SweepMpi, OneRankRunsAsALocalSweep) {
   ASSERT_EQ(run(mpirun_sweep(1, {kSmoke, "--out", out.string(), "--jobs", "1"}), log), 0) << slurp(log);
   EXPECT_NE(slurp(log).find("with 1 job(s)"), std::string::npos) << slurp(log);
   expect_same_records(local_smoke(), out);
+}
+
+// The tippe command maps no MPI library at start-up (a reference run, --version): only the MPI
+// module links it, opened under a launcher; the loader lists what the command needs.
+TEST(SweepMpi, TheCommandMapsNoMpiLibraryUntilALauncherStartsIt) {
+  TempDir dir("tippe-mpi-maps");
+  const fs::path log = dir.path() / "log";
+  ::setenv("LD_TRACE_LOADED_OBJECTS", "1", 1);
+  const int rc = run({fixtures::kTippeBinary, "--version"}, log);
+  ::unsetenv("LD_TRACE_LOADED_OBJECTS");
+  ASSERT_EQ(rc, 0) << slurp(log);
+  EXPECT_NE(slurp(log).find("libtippe_runtime"), std::string::npos) << slurp(log);
+  EXPECT_EQ(slurp(log).find("libmpi"), std::string::npos) << slurp(log);
+  EXPECT_EQ(slurp(log).find("libopen-pal"), std::string::npos) << slurp(log);
+  EXPECT_FALSE(mpi_library_version().empty());  // the module opens and answers
 }
 
 #else
