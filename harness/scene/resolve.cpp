@@ -25,6 +25,9 @@ std::string resolve_file(const Scene& s, const EngineFileSetting& f, SettingValu
   if (path->empty()) fail(s, f, "is empty (expected a path to " + f.what + ")");
   std::filesystem::path p(*path);
   if (p.is_relative()) p = std::filesystem::path(s.source_file).parent_path() / p;
+  // Read where the runs will read (the value is stored normalized), so that "out/../model.xml"
+  // of a scene checked before its directory out/ exists (import-mjcf --out out/top.toml) is read.
+  p = p.lexically_normal();
   std::error_code ec;
   if (std::filesystem::is_directory(p, ec)) fail(s, f, p.string() + ": is a directory");
   std::string bytes;
@@ -33,7 +36,7 @@ std::string resolve_file(const Scene& s, const EngineFileSetting& f, SettingValu
   } catch (const std::runtime_error& e) {
     fail(s, f, e.what());
   }
-  value = p.lexically_normal().string();
+  value = p.string();
   return bytes;
 }
 

@@ -336,5 +336,28 @@ TEST_F(ImportMjcfScene, SceneStartAndOptionsOverrideTheModel) {
   EXPECT_EQ(settings2["integrator"], "RK4");
 }
 
+// `--out` into a directory that does not exist yet (a new user's first `--out out/my_top.toml`):
+// the scene names the model relative to out/, and its check before writing must read that model,
+// not "out/../top.xml" through a directory that is not there.
+TEST_F(ImportMjcfScene, OutIntoADirectoryThatDoesNotExistYet) {
+  const fs::path scene = dir_ / "new" / "deeper" / "my_top.toml";
+  ASSERT_FALSE(fs::exists(dir_ / "new"));
+  const ChildExit e = wait_process_within(
+      spawn_process({kBinary, "import-mjcf", (dir_ / "top.xml").string(), "--out", scene.string()}, dir_ / "out2",
+                    dir_ / "err2"),
+      60);
+  std::ifstream err(dir_ / "err2");
+  std::stringstream text;
+  text << err.rdbuf();
+  ASSERT_EQ(e.code, 0) << text.str();
+  ASSERT_TRUE(fs::exists(scene));
+  std::ifstream written(scene);
+  std::stringstream toml;
+  toml << written.rdbuf();
+  EXPECT_NE(toml.str().find("\"../../top.xml\""), std::string::npos) << "named relative to the scene\n" << toml.str();
+  const Scene loaded = load_scene(scene.string());
+  EXPECT_EQ(std::get<std::string>(loaded.engines.at("mujoco").at("model")), (dir_ / "top.xml").lexically_normal().string());
+}
+
 }  // namespace
 }  // namespace tippe
