@@ -170,6 +170,9 @@ SiconosSimulator::SiconosSimulator(const Scene& scene)
   sim_->setNewtonMaxIteration(settings_.newton_max_iterations);
   sim_->initialize();
 
+  // Moreau-Jean's impulse acts through the relations evaluated at q_n+1, whose contact points
+  // read_contacts reports.
+  checks_.set_impulse_at_step_end();
   checks_.start(read_state());
   make_notes();
 }
