@@ -50,6 +50,27 @@ void finish_surface_points(ContactReport& r) {
   if (r.weight_stem > 0) r.p_WC_stem /= r.weight_stem;
 }
 
+void add_stage_forces(StepMeanForces& mean, const ContactReport& stage, double weight, const Vec3& shift_W) {
+  mean.set = true;
+  mean.normal_ball += weight * stage.normal_force_ball;
+  mean.normal_stem += weight * stage.normal_force_stem;
+  mean.friction_ball_W += weight * stage.friction_ball_W;
+  mean.friction_stem_W += weight * stage.friction_stem_W;
+  if (stage.weight_ball > 0) {
+    mean.p_WC_ball += weight * stage.weight_ball * (stage.p_WC_ball - shift_W);
+    mean.weight_ball += weight * stage.weight_ball;
+  }
+  if (stage.weight_stem > 0) {
+    mean.p_WC_stem += weight * stage.weight_stem * (stage.p_WC_stem - shift_W);
+    mean.weight_stem += weight * stage.weight_stem;
+  }
+}
+
+void finish_stage_forces(StepMeanForces& mean) {
+  if (mean.weight_ball > 0) mean.p_WC_ball /= mean.weight_ball;
+  if (mean.weight_stem > 0) mean.p_WC_stem /= mean.weight_stem;
+}
+
 EngineContactForces contact_forces(const ContactReport& r) {
   EngineContactForces f;
   f.ball = {r.ball, r.normal_force_ball, r.friction_ball_W, r.weight_ball > 0, r.p_WC_ball};
@@ -168,28 +189,38 @@ void StepChecks::add_friction_work(const BodyState& y, double h, const ContactRe
   const Vec3 w_W = y.q_WB * y.w_B;
   const BodyState& x = last_.state;
   const Vec3 w0_W = x.q_WB * x.w_B;
+  // The step's forces: the report's, or the weighted stages' where the adapter gave them.
+  const StepMeanForces& m = c.step_mean;
   for (const Surface s : {Surface::Ball, Surface::Stem}) {
     const bool stem = s == Surface::Stem;
-    const Vec3& f = stem ? c.friction_stem_W : c.friction_ball_W;
-    const double f_n = stem ? c.normal_force_stem : c.normal_force_ball;
+    const Vec3& f = m.set ? (stem ? m.friction_stem_W : m.friction_ball_W) : (stem ? c.friction_stem_W : c.friction_ball_W);
+    const double f_n = m.set ? (stem ? m.normal_stem : m.normal_ball) : (stem ? c.normal_force_stem : c.normal_force_ball);
     if ((f.isZero(0.0) && f_n == 0.0) || (stem && !body_.stem)) continue;
-    const double weight = stem ? c.weight_stem : c.weight_ball;
-    const Vec3 r = weight > 0 ? Vec3((stem ? c.p_WC_stem : c.p_WC_ball) - y.p_WG) : contact_offset_W(body_, y.q_WB, s);
-    const Vec3 v_end = y.v_WG + w_W.cross(r);
+    const double weight = m.set ? (stem ? m.weight_stem : m.weight_ball) : (stem ? c.weight_stem : c.weight_ball);
+    const Vec3& p_WC = m.set ? (stem ? m.p_WC_stem : m.p_WC_ball) : (stem ? c.p_WC_stem : c.p_WC_ball);
     if (smooth_forces_) {
-      // A force law read at the step's end (Simbody): its power there times the step. (The
-      // trapezoid of the power at the step's two ends was measured further from the work the
-      // bench applied on toy_viscous, 1.1e-3 relative against 1.1e-5, and from the energy error
-      // on the frictionless top: test_contact_forces.cpp, test_energy_ledger.cpp.)
+      // A force law read at the step's end (Simbody), at its point there: its power at the end
+      // times the step. (The trapezoid of the power at the step's two ends was measured further
+      // from the work the bench applied on toy_viscous, 1.1e-3 relative against 1.1e-5, and from
+      // the energy error on the frictionless top: test_contact_forces.cpp, test_energy_ledger.cpp.)
+      const Vec3 r = weight > 0 ? Vec3(p_WC - y.p_WG) : contact_offset_W(body_, y.q_WB, s);
+      const Vec3 v_end = y.v_WG + w_W.cross(r);
       friction_work_ += f.dot(v_end) * h;
       normal_work_ += f_n * v_end.z() * h;
       continue;
     }
-    // At the start the force's point is where the contact was then: a rolling top's contact
-    // point moves over its surface (by ~w h R a step), so the start's point is the start state's
-    // geometric contact point shifted as the engine's point is from the end's.
-    const Vec3 r0 = r + contact_offset_W(body_, x.q_WB, s) - contact_offset_W(body_, y.q_WB, s);
-    const Vec3 v_C = 0.5 * (v_end + x.v_WG + w0_W.cross(r0));
+    // A solver's impulse acts at the point its contact Jacobian was built at, where the engine
+    // reports its point (or, with none, the geometric contact point): the collision of the step's
+    // start state, or its end's for an engine that said so (set_impulse_at_step_end). Its lever
+    // arm is that point from the same state's centre of mass, and the same lever arm in the lab
+    // frame gives the material point's velocity at both ends, as the engine's velocity update
+    // v+ = v- + M^-1 J^T P uses it. (The arm from the step's end G for an engine whose point is
+    // the start's, off by v_G h, with the start's geometric point shifted for the other end,
+    // booked 4.2-4.9e-4 E0 of work that no force did over the first second of leine_glocker in
+    // Bullet, ODE and DART alike: test_energy_ledger_steps.cpp.)
+    const BodyState& at = impulse_at_end_ ? y : x;
+    const Vec3 r = weight > 0 ? Vec3(p_WC - at.p_WG) : contact_offset_W(body_, at.q_WB, s);
+    const Vec3 v_C = 0.5 * (x.v_WG + w0_W.cross(r) + y.v_WG + w_W.cross(r));
     friction_work_ += f.dot(v_C) * h;
     normal_work_ += f_n * v_C.z() * h;
   }

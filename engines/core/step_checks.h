@@ -11,6 +11,19 @@
 
 namespace tippe {
 
+// The contact forces of a step as the ledger books them, where they differ from the report's own
+// (which stay the last evaluation's, for the events, the observables and the gliding law): an
+// engine whose step evaluates its contact several times (MuJoCo's RK4: four stages, its velocity
+// update their weighted sum) gives the weighted sum of the stages' forces, each stage's point
+// moved with its centre of mass to the step's start (add_stage_forces).
+struct StepMeanForces {
+  bool set = false;
+  double normal_ball = 0.0, normal_stem = 0.0;
+  Vec3 friction_ball_W = Vec3::Zero(), friction_stem_W = Vec3::Zero();
+  Vec3 p_WC_ball = Vec3::Zero(), p_WC_stem = Vec3::Zero();  // F_n-weighted sums, then points
+  double weight_ball = 0.0, weight_stem = 0.0;
+};
+
 // What an engine says about its contacts after a step.
 struct ContactReport {
   bool ball = false;               // the engine has a contact on the ball geom
@@ -25,7 +38,14 @@ struct ContactReport {
   Vec3 friction_ball_W = Vec3::Zero(), friction_stem_W = Vec3::Zero();
   Vec3 p_WC_ball = Vec3::Zero(), p_WC_stem = Vec3::Zero();
   double weight_ball = 0.0, weight_stem = 0.0;  // the positive F_n summed into each point
+  StepMeanForces step_mean;  // set by an adapter whose step's forces are not the report's
 };
+
+// Adds a stage's report (finished) to `mean` with its weight in the step's velocity update, its
+// points moved by shift_W (the stage's centre of mass to the step start's); finish_stage_forces
+// turns the weighted sums into points once every stage is in.
+void add_stage_forces(StepMeanForces& mean, const ContactReport& stage, double weight, const Vec3& shift_W);
+void finish_stage_forces(StepMeanForces& mean);
 
 // The potential an engine's soft contact law gives its normal force as a function of the
 // penetration depth d of a surface (the elastic part of the law, its damping left out):
@@ -77,6 +97,11 @@ class StepChecks {
   // solver's impulse over the step: the ledger books their power at the step's end times the
   // step instead of the impulse's exact work (the force times the step's mean point velocity).
   void set_smooth_forces() { smooth_forces_ = true; }
+  // The engine's contact impulse acts through the contact Jacobian of the step's end state, at the
+  // point it reports there (Siconos' Moreau-Jean scheme evaluates its relations at q_n+1), not
+  // the start's (a semi-implicit Euler step's collision before the solve: Bullet, ODE, MuJoCo's
+  // Euler, DART): the ledger takes the force's lever arm from the end's centre of mass.
+  void set_impulse_at_step_end() { impulse_at_end_ = true; }
   // A state set from outside: the probes restart from it, so no crossing is found across the jump.
   void restart(const BodyState& x);
   // After a step ending at time t in state y with the engine's contacts c: events, then the
@@ -121,7 +146,7 @@ class StepChecks {
   StepProbe last_;
   bool inverted_ = false, stem_touched_ = false;
   double friction_work_ = 0.0, normal_work_ = 0.0;
-  bool smooth_forces_ = false;
+  bool smooth_forces_ = false, impulse_at_end_ = false;
   bool has_potential_ = false;
   ContactPotential potential_;
   double elastic(const StepProbe& p) const;

@@ -1,5 +1,6 @@
 // MuJoCo 2.2.2 adapter: the scene as MJCF (one free body at G with a ball and a stem geom on a plane), or the user's own MJCF as written, stepped by the shared fixed-step loop.
 #include "engines/mujoco/mujoco_sim.h"
+#include "engines/mujoco/mujoco_rk4.h"
 
 #include <mujoco/mujoco.h>
 
@@ -296,7 +297,12 @@ void MujocoSimulator::make_notes(const std::string& compiler_warning) {
 void MujocoSimulator::engine_step() {
   int before[mjNWARNING];
   for (int i = 0; i < mjNWARNING; ++i) before[i] = d_->warning[i].number;
-  mj_step(m_, d_);
+  // RK4's velocity update is the weighted sum of its four stages' forces, of which MuJoCo keeps
+  // the last: stepped stage by stage (the same arithmetic), the ledger books that sum.
+  const bool stepwise = rk4_stepwise_supported(m_);
+  StepMeanForces mean;
+  if (stepwise) mean = rk4_step_mean_forces(m_, d_, body_id_, [this](const mjData* d) { return read_contacts(d); });
+  else mj_step(m_, d_);
   // apply_force_W acts for one step only.
   mju_zero(d_->qfrc_applied, m_->nv);
   // With RK4 this is the last of the four solves of the step (MuJoCo keeps no total).
@@ -314,6 +320,7 @@ void MujocoSimulator::engine_step() {
     else if (fired(mjWARN_INERTIA)) limit_ = "mujoco: (near) singular inertia matrix";
   }
   report_ = read_contacts();
+  if (stepwise) report_.step_mean = mean;
 }
 
 BodyState MujocoSimulator::engine_state() const {
