@@ -39,11 +39,21 @@ BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSp
   return out;
 }
 
+void add_bench_wrench(BenchWrench& b, const BenchFrictionForces& f, int i, double weight) {
+  const Vec3 force = weight * f.f_W[i];
+  (f.stem[i] ? b.f_stem_W : b.f_ball_W) += force;
+  (f.stem[i] ? b.m_stem_W : b.m_ball_W) += f.r_GC_W[i].cross(force);
+}
+
 void add_bench_friction(ContactReport& r, const BenchFrictionForces& f) {
   for (int i = 0; i < f.n; ++i) {
     (f.stem[i] ? r.friction_stem_W : r.friction_ball_W) += f.f_W[i];
+    add_bench_wrench(r.bench, f, i, 1.0);
     // The bench's force acts over the whole step: in the step's mean as it is.
-    if (r.step_mean.set) (f.stem[i] ? r.step_mean.friction_stem_W : r.step_mean.friction_ball_W) += f.f_W[i];
+    if (r.step_mean.set) {
+      (f.stem[i] ? r.step_mean.friction_stem_W : r.step_mean.friction_ball_W) += f.f_W[i];
+      add_bench_wrench(r.step_mean.bench, f, i, 1.0);
+    }
   }
 }
 

@@ -39,6 +39,9 @@ BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSp
 // Adds the forces f the bench applied over the step to r's per-surface friction forces (the
 // engine's own contact is frictionless under these laws, so they are the friction of the step).
 void add_bench_friction(ContactReport& r, const BenchFrictionForces& f);
+// Adds weight times f's force i, and its moment about the centre of mass at the force's lever
+// arm, to b: the bench's part of the friction, which the ledger books at the bench's point.
+void add_bench_wrench(BenchWrench& b, const BenchFrictionForces& f, int i, double weight);
 
 // The engine's contacts r with the bench's friction f of the step added: the contacts of the
 // step as the checks, the work and contact_forces() read them (add_bench_friction on a copy).

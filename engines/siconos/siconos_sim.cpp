@@ -348,7 +348,10 @@ void SiconosSimulator::step_once() {
   finish_stage_forces(mean);
   for (const auto& [f, w] : {std::pair<const BenchFrictionForces*, double>{&bench_applied_, settings_.theta - 1.0},
                              {&bench_before_, 1.0 - settings_.theta}})
-    for (int i = 0; i < f->n; ++i) (f->stem[i] ? mean.friction_stem_W : mean.friction_ball_W) += w * f->f_W[i];
+    for (int i = 0; i < f->n; ++i) {
+      (f->stem[i] ? mean.friction_stem_W : mean.friction_ball_W) += w * f->f_W[i];
+      add_bench_wrench(mean.bench, *f, i, w);
+    }
   bench_before_ = bench_applied_;
   checks_.after_step(t, read_state(), report_);
 }
