@@ -40,11 +40,13 @@ BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSp
 }
 
 void add_bench_friction(ContactReport& r, const BenchFrictionForces& f) {
-  for (int i = 0; i < f.n; ++i) {
-    (f.stem[i] ? r.friction_stem_W : r.friction_ball_W) += f.f_W[i];
-    // The bench's force acts over the whole step: in the step's mean as it is.
-    if (r.step_mean.set) (f.stem[i] ? r.step_mean.friction_stem_W : r.step_mean.friction_ball_W) += f.f_W[i];
-  }
+  for (int i = 0; i < f.n; ++i) (f.stem[i] ? r.friction_stem_W : r.friction_ball_W) += f.f_W[i];
+  // The bench's force acts over the whole step: in the step's mean as it is (1 * f is f exactly).
+  if (r.step_mean.set) add_bench_friction_mean(r.step_mean, f, 1.0);
+}
+
+void add_bench_friction_mean(StepMeanForces& mean, const BenchFrictionForces& f, double weight) {
+  for (int i = 0; i < f.n; ++i) (f.stem[i] ? mean.friction_stem_W : mean.friction_ball_W) += weight * f.f_W[i];
 }
 
 }  // namespace tippe
