@@ -37,11 +37,15 @@ BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSp
                                           const ContactReport& c);
 
 // Adds the forces f the bench applied over the step to r's per-surface friction forces (the
-// engine's own contact is frictionless under these laws, so they are the friction of the step).
+// engine's own contact is frictionless under these laws, so they are the friction of the step),
+// and to its step mean where the adapter set one (add_bench_friction_mean, weight 1); each force
+// with its moment about the centre of mass in `bench`, which the ledger books at the bench's point.
 void add_bench_friction(ContactReport& r, const BenchFrictionForces& f);
-// Adds weight times f's force i, and its moment about the centre of mass at the force's lever
-// arm, to b: the bench's part of the friction, which the ledger books at the bench's point.
-void add_bench_wrench(BenchWrench& b, const BenchFrictionForces& f, int i, double weight);
+
+// Adds weight * f to the step mean's per-surface friction forces, force by force: 1 where the
+// bench's force acted over the whole step as it is, an integrator's weight where the engine
+// applied it as a blend of several (Siconos' Moreau-Jean: theta and 1 - theta).
+void add_bench_friction_mean(StepMeanForces& mean, const BenchFrictionForces& f, double weight);
 
 // The engine's contacts r with the bench's friction f of the step added: the contacts of the
 // step as the checks, the work and contact_forces() read them (add_bench_friction on a copy).

@@ -4,14 +4,12 @@
 
 #include <mujoco/mujoco.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <locale>
 #include <memory>
 #include <mutex>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,6 +18,7 @@
 #include "engines/core/fixed_step.h"
 #include "engines/mujoco/mujoco_api.h"
 #include "engines/mujoco/mujoco_mjcf.h"
+#include "engines/mujoco/mujoco_notes.h"
 #include "engines/mujoco/mujoco_settings.h"
 #include "engines/mujoco/mujoco_top.h"
 #include "engines/mujoco/mujoco_user_model.h"
@@ -30,8 +29,6 @@ namespace tippe {
 namespace {
 
 using namespace mujoco_detail;
-
-std::string num(double v) { return round_trip_text(v); }
 
 // MuJoCo's default warning handler prints to stdout (where the harness may write records) and
 // appends to MUJOCO_LOG.TXT in the working directory; warnings that matter are read from
@@ -210,86 +207,15 @@ void MujocoSimulator::init_user_model(const Scene& scene) {
 
 SettingsList MujocoSimulator::settings() const {
   if (user_) return user_model_settings(m_, top_, settings_.model, keyframe_start_);
-  SettingsList list = list_settings(settings_);
-  // The user-model keys are empty for the bench's own MJCF: left out, so that its records list
-  // exactly the settings in force.
-  list.erase(std::remove_if(list.begin(), list.end(),
-                            [](const auto& kv) { return kv.first == "model" || kv.first == "body" || kv.first == "keyframe"; }),
-             list.end());
-  const Vec3 f = used_friction(settings_, scene());
-  list.emplace_back("condim_used", std::to_string(condim_));
-  list.emplace_back("friction_used", "[" + num(f.x()) + ", " + num(f.y()) + ", " + num(f.z()) + "]");
-  list.emplace_back("noslip_iterations_used", std::to_string(used_noslip_iterations(settings_, scene())));
-  const std::vector<double> sr = used_solref(settings_);
-  list.emplace_back("solref_used", "[" + num(sr[0]) + ", " + num(sr[1]) + "]");
-  return list;
+  return scene_model_settings(settings_, scene(), condim_);
 }
 
 void MujocoSimulator::make_notes(const std::string& compiler_warning) {
-  const Scene& sc = scene();
-  const BodyModel& m = body();
-  const ContactSpec& c = sc.contact;
-  auto g = [](double v) {
-    std::ostringstream os;
-    os << v;
-    return os.str();
-  };
   notes_ = friction_law_notes({"MuJoCo", " (mj_applyFT)", "MuJoCo's previous step (mj_contactForce, explicit)",
                                " and " + std::to_string(settings_.noslip_iterations_rolling) + " noslip iterations"},
                               settings_.rolling_mu);
-  if (c.friction == FrictionLaw::Coulomb && !(c.mu > 0) && settings_.condim == 0)
-    notes_.push_back("Coulomb friction with mu = 0 simulated as frictionless contact (condim 1)");
-  if (condim_ >= 3 && (c.friction == FrictionLaw::Coulomb || c.friction == FrictionLaw::Rolling) &&
-      settings_.cone == "pyramidal")
-    notes_.push_back("friction cone approximated by MuJoCo's pyramid (cone = pyramidal)");
-  // The scene's drilling law against MuJoCo's cone: the elliptic cone with condim >= 4 is the
-  // coupled law's ellipse itself (MuJoCo: f_n^2 >= sum f_i^2 / mu_i^2), so a coupled scene runs
-  // natively and a decoupled one does not; the pyramid bounds them jointly too, by a polytope.
-  const bool coupled = c.drilling_law == DrillingLaw::Coupled;
-  if (condim_ >= 4 && c.drilling > 0 && settings_.cone == "elliptic" && !coupled)
-    notes_.push_back("drilling friction (condim " + std::to_string(condim_) +
-                     "): MuJoCo bounds the tangential force and the drilling torque jointly, (|F_t|/mu)^2 + (tau/mu_d)^2 <= F_n^2 (elliptic), not each alone");
-  if (condim_ >= 4 && c.drilling > 0 && settings_.cone == "elliptic" && coupled)
-    notes_.push_back("drilling coupled natively (condim " + std::to_string(condim_) +
-                     ", elliptic cone): MuJoCo's cone (|F_t|/mu)^2 + (tau/mu_d)^2 <= F_n^2 is the scene's Leine-Glocker ellipse");
-  if (condim_ >= 4 && c.drilling > 0 && settings_.cone == "pyramidal")
-    notes_.push_back(std::string("drilling ") + (coupled ? "coupled by a polytope, not the scene's ellipse" : "coupled, not each bounded alone") +
-                     " (condim " + std::to_string(condim_) +
-                     ", cone = pyramidal): MuJoCo's pyramid bounds the tangential force and the drilling torque jointly by its edges n +- mu_i d_i");
-  if (coupled && c.drilling > 0 && condim_ < 4)
-    notes_.push_back("drilling dropped (condim " + std::to_string(condim_) + " has no torsional row): not the scene's coupled law");
-  // MuJoCo raises every friction coefficient the contact uses to mjMINMU.
-  const Vec3 f = used_friction(settings_, scene());
-  const bool zero_used = (condim_ >= 3 && !(f.x() > 0)) || (condim_ >= 4 && !(f.y() > 0)) || condim_ == 6;
-  if (zero_used)
-    notes_.push_back("a friction coefficient of 0 with condim " + std::to_string(condim_) +
-                     " acts as MuJoCo's minimum mjMINMU = 1e-5, not as frictionless");
-  if (settings_.condim != 0 && settings_.condim != derived_condim(sc))
-    notes_.push_back("condim forced to " + std::to_string(settings_.condim) + " (the scene's law needs " +
-                     std::to_string(derived_condim(sc)) + "): not the scene's contact law");
-  if (used_solref(settings_)[0] != settings_.solref[0])
-    notes_.push_back("solref timeconst " + g(settings_.solref[0]) + " raised by MuJoCo to 2 timestep = " +
-                     g(used_solref(settings_)[0]) + " (its refsafe rule)");
-  notes_.push_back(std::string("body frame at ") +
-                   (settings_.body_frame == "com" ? "the centre of mass G" : "the ball's centre O") +
-                   " (engines.mujoco.body_frame): MuJoCo's results depend on it");
-  if (settings_.solref[0] > 0) {
-    // Resting on the ball: d k r = (1 - d) g with k = d / (dmax^2 tc^2 zeta^2) and d ~ dmin
-    // for r << width (MuJoCo's soft-constraint model).
-    const double dmin = settings_.solimp[0], dmax = settings_.solimp[1];
-    const double tc = used_solref(settings_)[0], zeta = settings_.solref[1];
-    const double depth = (1 - dmin) / (dmin * dmin) * sc.gravity * dmax * dmax * tc * tc * zeta * zeta;
-    notes_.push_back("soft contact (solref, solimp): resting penetration about " + g(depth) + " = " +
-                     g(depth / m.R) + " R" + (condim_ >= 3 ? "; sticking friction creeps" : ""));
-  } else {
-    notes_.push_back("soft contact given as stiffness and damping (negative solref)");
-  }
-  // Documented for MuJoCo's convex model ("the only way to initiate slip is to generate some
-  // motion in the normal direction") and seen here as contact on/off chatter while sliding.
-  if (condim_ >= 3 && (c.friction == FrictionLaw::Coulomb || c.friction == FrictionLaw::Rolling))
-    notes_.push_back("while slipping, MuJoCo's convex contact pushes the ball off the floor: the contact hops (intermittent normal force, many switch events)");
-  if (settings_.integrator != "RK4")
-    notes_.push_back("integrator " + settings_.integrator + ": first order in the timestep");
+  const std::vector<std::string> mujoco = scene_model_notes(scene(), body(), settings_, condim_);
+  notes_.insert(notes_.end(), mujoco.begin(), mujoco.end());
   if (!full_sphere_note().empty()) notes_.push_back(full_sphere_note());
   if (!compiler_warning.empty()) notes_.push_back("mujoco compiler: " + compiler_warning);
 }

@@ -346,12 +346,9 @@ void SiconosSimulator::step_once() {
   StepMeanForces& mean = report_.step_mean;
   add_stage_forces(mean, report_, 1.0, Vec3::Zero());
   finish_stage_forces(mean);
-  for (const auto& [f, w] : {std::pair<const BenchFrictionForces*, double>{&bench_applied_, settings_.theta - 1.0},
-                             {&bench_before_, 1.0 - settings_.theta}})
-    for (int i = 0; i < f->n; ++i) {
-      (f->stem[i] ? mean.friction_stem_W : mean.friction_ball_W) += w * f->f_W[i];
-      add_bench_wrench(mean.bench, *f, i, w);
-    }
+  // The report holds this step's force once (weight 1): theta - 1 more of it makes theta.
+  add_bench_friction_mean(mean, bench_applied_, settings_.theta - 1.0);
+  add_bench_friction_mean(mean, bench_before_, 1.0 - settings_.theta);
   bench_before_ = bench_applied_;
   checks_.after_step(t, read_state(), report_);
 }

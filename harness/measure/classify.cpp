@@ -56,8 +56,7 @@ std::optional<Finding> first_energy_gain(const Scene& scene, const Trajectory& t
   const bool relative = tr.energy[0] != 0;
   const bool ledger = rule == EnergyGainRule::Ledger && !tr.numerical_energy.empty() &&
                       std::isfinite(tr.numerical_energy.back());
-  const bool stored = rule == EnergyGainRule::Stored && tr.elastic_energy.size() == tr.size() && tr.size() &&
-                      std::isfinite(tr.elastic_energy[0]);
+  const bool stored = rule == EnergyGainRule::Stored && has_elastic_store(tr);
   return Finding{g.time, std::string(ledger   ? "energy created (by the ledger: not friction work, not released from the contact's store) rose by "
                                      : stored ? "energy with the contact's stored elastic energy rose by "
                                               : "energy rose by ") +

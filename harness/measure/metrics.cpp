@@ -122,11 +122,15 @@ EnergyGainRule energy_gain_rule(const Scene& scene) {
   return it == names.end() ? kDefaultEnergyGainRule : static_cast<EnergyGainRule>(it - names.begin());
 }
 
+bool has_elastic_store(const Trajectory& tr) {
+  return tr.elastic_energy.size() == tr.size() && tr.size() > 0 && std::isfinite(tr.elastic_energy[0]);
+}
+
 std::vector<double> energy_counted(const Trajectory& tr, EnergyGainRule rule) {
   if (rule == EnergyGainRule::Stored) {
-    // E + U - U0 where the run has a store from its first sample on (a per-run property of the
-    // engine's contact law); a later sample without one (a divergence) counts E alone.
-    if (tr.elastic_energy.size() != tr.size() || !tr.size() || !std::isfinite(tr.elastic_energy[0])) return tr.energy;
+    // E + U - U0 where the run has a store from its first sample on; a later sample without one
+    // (a divergence) counts E alone.
+    if (!has_elastic_store(tr)) return tr.energy;
     std::vector<double> c(tr.energy);
     const double u0 = tr.elastic_energy[0];
     for (size_t k = 0; k < tr.size(); ++k)
@@ -137,7 +141,7 @@ std::vector<double> energy_counted(const Trajectory& tr, EnergyGainRule rule) {
   std::vector<double> c(tr.size());
   const double e0 = tr.size() ? tr.energy[0] : 0.0;
   const bool store = tr.elastic_energy.size() == tr.size() && tr.normal_work.size() == tr.size();
-  const double u0 = store && tr.size() && std::isfinite(tr.elastic_energy[0]) ? tr.elastic_energy[0] : 0.0;
+  const double u0 = store && has_elastic_store(tr) ? tr.elastic_energy[0] : 0.0;
   for (size_t k = 0; k < tr.size(); ++k) {
     const double n = tr.numerical_energy[k];
     if (!std::isfinite(n)) {

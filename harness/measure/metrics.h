@@ -97,6 +97,10 @@ std::string energy_counted_text(EnergyGainRule r);
 // The rule a scene asks for (run.energy_gain_rule, validated when the scene was read; its default
 // "stored" is kDefaultEnergyGainRule).
 EnergyGainRule energy_gain_rule(const Scene& scene);
+// Whether the run has a store of elastic energy: U given at every sample and finite at the first
+// (a per-run property of the engine's contact law). Stored counts E + U - U0 where it has, E
+// where not; Ledger takes U0 from it; the class's message says which energy rose.
+bool has_elastic_store(const Trajectory& trajectory);
 // The series the rule is applied to, one value per sample (E + U - U0 under Stored, E0 + C(t)
 // under Ledger, E under Total).
 std::vector<double> energy_counted(const Trajectory& trajectory, EnergyGainRule rule);

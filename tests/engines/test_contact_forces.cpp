@@ -225,5 +225,32 @@ TEST_P(ContactForcesTest, ViscousFrictionWorkIsTheWorkTheBenchApplied) {
 INSTANTIATE_TEST_SUITE_P(Engines, ContactForcesTest, ::testing::ValuesIn(kRows),
                          [](const ::testing::TestParamInfo<ForceRow>& info) { return std::string(info.param.engine); });
 
+TEST(BenchFrictionMean, AddsEachForceByItsWeightToItsSurface) {
+  BenchFrictionForces f;
+  f.n = 2;
+  f.stem[0] = false;
+  f.stem[1] = true;
+  f.f_W[0] = Vec3(0.1, -0.3, 0.0);
+  f.f_W[1] = Vec3(-0.7, 0.2, 0.0);
+  StepMeanForces mean;
+  mean.friction_ball_W = Vec3(1.0, 2.0, 0.0);
+  add_bench_friction_mean(mean, f, 0.25);
+  EXPECT_EQ(mean.friction_ball_W, Vec3(1.0, 2.0, 0.0) + 0.25 * f.f_W[0]);
+  EXPECT_EQ(mean.friction_stem_W, 0.25 * f.f_W[1]);
+  // The report's step mean, where an adapter set one, gets the force as it is (weight 1),
+  // bit for bit what a plain sum gives; an unset one is left alone.
+  ContactReport r;
+  r.step_mean.set = true;
+  r.step_mean.friction_ball_W = Vec3(1.0 / 3.0, 0.1, 0.0);
+  add_bench_friction(r, f);
+  EXPECT_EQ(r.step_mean.friction_ball_W, Vec3(1.0 / 3.0, 0.1, 0.0) + f.f_W[0]);
+  EXPECT_EQ(r.step_mean.friction_stem_W, f.f_W[1]);
+  EXPECT_EQ(r.friction_stem_W, f.f_W[1]);
+  ContactReport unset;
+  add_bench_friction(unset, f);
+  EXPECT_EQ(unset.step_mean.friction_ball_W, Vec3::Zero());
+  EXPECT_EQ(unset.friction_ball_W, f.f_W[0]);
+}
+
 }  // namespace
 }  // namespace tippe

@@ -117,6 +117,22 @@ TEST(Classify, StoredRuleWithoutAStoreCountsE) {
   EXPECT_EQ(c.front(), ends.energy.front()) << "the first sample is E0 under every rule";
 }
 
+TEST(EnergyGainRule, AStoreIsUFiniteAtTheFirstSampleWithOneUPerSample) {
+  // The one predicate the counted energy and the class's wording share.
+  EXPECT_TRUE(has_elastic_store(ledger_trajectory(true, 1.0)));
+  EXPECT_FALSE(has_elastic_store(ledger_trajectory(false, 1.0))) << "n/a from the first sample";
+  Trajectory later = ledger_trajectory(true, 1.0);
+  later.elastic_energy.back() = std::nan("");
+  EXPECT_TRUE(has_elastic_store(later)) << "a store that ends later is still the run's";
+  Trajectory first = ledger_trajectory(true, 1.0);
+  first.elastic_energy.front() = std::nan("");
+  EXPECT_FALSE(has_elastic_store(first));
+  Trajectory short_u = ledger_trajectory(true, 1.0);
+  short_u.elastic_energy.pop_back();
+  EXPECT_FALSE(has_elastic_store(short_u)) << "U not given for every sample";
+  EXPECT_FALSE(has_elastic_store(Trajectory{})) << "no sample";
+}
+
 TEST(Classify, LedgerRuleWithoutTheElasticEnergyCountsNormalWorkAsExchange) {
   // Where the engine's contact law gives no elastic energy (n/a), the normal force's work is
   // counted as an exchange with the contact's store: the rise it explains is not a gain.
