@@ -39,14 +39,32 @@ BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSp
   return out;
 }
 
+namespace {
+
+// Adds weight times f's force i, and its moment about the centre of mass at the force's lever
+// arm, to b: the bench's part of the friction, which the ledger books at the bench's point.
+void add_bench_wrench(BenchWrench& b, const BenchFrictionForces& f, int i, double weight) {
+  const Vec3 force = weight * f.f_W[i];
+  (f.stem[i] ? b.f_stem_W : b.f_ball_W) += force;
+  (f.stem[i] ? b.m_stem_W : b.m_ball_W) += f.r_GC_W[i].cross(force);
+}
+
+}  // namespace
+
 void add_bench_friction(ContactReport& r, const BenchFrictionForces& f) {
-  for (int i = 0; i < f.n; ++i) (f.stem[i] ? r.friction_stem_W : r.friction_ball_W) += f.f_W[i];
+  for (int i = 0; i < f.n; ++i) {
+    (f.stem[i] ? r.friction_stem_W : r.friction_ball_W) += f.f_W[i];
+    add_bench_wrench(r.bench, f, i, 1.0);
+  }
   // The bench's force acts over the whole step: in the step's mean as it is (1 * f is f exactly).
   if (r.step_mean.set) add_bench_friction_mean(r.step_mean, f, 1.0);
 }
 
 void add_bench_friction_mean(StepMeanForces& mean, const BenchFrictionForces& f, double weight) {
-  for (int i = 0; i < f.n; ++i) (f.stem[i] ? mean.friction_stem_W : mean.friction_ball_W) += weight * f.f_W[i];
+  for (int i = 0; i < f.n; ++i) {
+    (f.stem[i] ? mean.friction_stem_W : mean.friction_ball_W) += weight * f.f_W[i];
+    add_bench_wrench(mean.bench, f, i, weight);
+  }
 }
 
 }  // namespace tippe

@@ -38,7 +38,8 @@ BenchFrictionForces bench_friction_forces(const BodyModel& body, const ContactSp
 
 // Adds the forces f the bench applied over the step to r's per-surface friction forces (the
 // engine's own contact is frictionless under these laws, so they are the friction of the step),
-// and to its step mean where the adapter set one (add_bench_friction_mean, weight 1).
+// and to its step mean where the adapter set one (add_bench_friction_mean, weight 1); each force
+// with its moment about the centre of mass in `bench`, which the ledger books at the bench's point.
 void add_bench_friction(ContactReport& r, const BenchFrictionForces& f);
 
 // Adds weight * f to the step mean's per-surface friction forces, force by force: 1 where the

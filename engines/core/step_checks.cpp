@@ -56,6 +56,12 @@ void add_stage_forces(StepMeanForces& mean, const ContactReport& stage, double w
   mean.normal_stem += weight * stage.normal_force_stem;
   mean.friction_ball_W += weight * stage.friction_ball_W;
   mean.friction_stem_W += weight * stage.friction_stem_W;
+  // The bench's moments are about each stage's centre of mass; a force held over the step has
+  // the same moment about the step start's (the adapters add the bench's part after the stages).
+  mean.bench.f_ball_W += weight * stage.bench.f_ball_W;
+  mean.bench.f_stem_W += weight * stage.bench.f_stem_W;
+  mean.bench.m_ball_W += weight * stage.bench.m_ball_W;
+  mean.bench.m_stem_W += weight * stage.bench.m_stem_W;
   if (stage.weight_ball > 0) {
     mean.p_WC_ball += weight * stage.weight_ball * (stage.p_WC_ball - shift_W);
     mean.weight_ball += weight * stage.weight_ball;
@@ -221,9 +227,23 @@ void StepChecks::add_friction_work(const BodyState& y, double h, const ContactRe
     const BodyState& at = impulse_at_end_ ? y : x;
     const Vec3 r = weight > 0 ? Vec3(p_WC - at.p_WG) : contact_offset_W(body_, at.q_WB, s);
     const Vec3 v_C = 0.5 * (x.v_WG + w0_W.cross(r) + y.v_WG + w_W.cross(r));
-    friction_work_ += f.dot(v_C) * h;
+    // The bench's part of the friction at the bench's own point: F . v_C = F . v_G + (r x F) . w
+    // with the step's mean velocities, which also holds for a weighted sum of forces at several
+    // points (Siconos' theta-mean of two steps' forces).
+    const BenchWrench& b = m.set ? m.bench : c.bench;
+    const Vec3& f_bench = stem ? b.f_stem_W : b.f_ball_W;
+    if (f_bench.isZero(0.0)) {
+      friction_work_ += f.dot(v_C) * h;
+    } else if (std::isfinite(c.bench.work)) {
+      friction_work_ += (f - f_bench).dot(v_C) * h;  // the bench's part: the adapter's work, below
+    } else {
+      const Vec3& m_bench = stem ? b.m_stem_W : b.m_ball_W;
+      const Vec3 v_G = 0.5 * (x.v_WG + y.v_WG), w_mean = 0.5 * (w0_W + w_W);
+      friction_work_ += ((f - f_bench).dot(v_C) + f_bench.dot(v_G) + m_bench.dot(w_mean)) * h;
+    }
     normal_work_ += f_n * v_C.z() * h;
   }
+  if (std::isfinite(c.bench.work) && c.bench.work != 0.0) friction_work_ += c.bench.work;
 }
 
 void StepChecks::track_events(const StepProbe& a, const StepProbe& b, const ContactReport& c) {

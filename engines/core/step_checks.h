@@ -11,6 +11,23 @@
 
 namespace tippe {
 
+// The part of a surface's friction force that the bench applied (a viscous or gliding law), and
+// its moment about the centre of mass, r_GC x F, with r_GC the lever arm the bench applied it at.
+// The ledger books this part at the bench's point, not at the engine's contact point: a soft
+// contact's point lies inside the penetration, and the two points' velocities differ by the spin
+// times that depth (MuJoCo's two-contact slide on toy_viscous booked 3e-4 E0 of work that no
+// force did, the same at every step: docs/findings/energy-ledger-per-run.md).
+struct BenchWrench {
+  Vec3 f_ball_W = Vec3::Zero(), f_stem_W = Vec3::Zero();
+  Vec3 m_ball_W = Vec3::Zero(), m_stem_W = Vec3::Zero();
+  // The work of these forces over the step as the engine integrated them, where the adapter
+  // measured it: an engine that holds the force as a generalized force in its own coordinates
+  // (MuJoCo's free joint: the torque in the body frame, turning with the body over the step)
+  // does work that the lab-frame moment above misses by O(h) per unit time. NaN: booked from the
+  // force and moment held in the lab frame (Bullet, ODE, DART, Siconos).
+  double work = std::numeric_limits<double>::quiet_NaN();
+};
+
 // The contact forces of a step as the ledger books them, where they differ from the report's own
 // (which stay the last evaluation's, for the events, the observables and the gliding law): an
 // engine whose step evaluates its contact several times (MuJoCo's RK4: four stages, its velocity
@@ -22,6 +39,7 @@ struct StepMeanForces {
   Vec3 friction_ball_W = Vec3::Zero(), friction_stem_W = Vec3::Zero();
   Vec3 p_WC_ball = Vec3::Zero(), p_WC_stem = Vec3::Zero();  // F_n-weighted sums, then points
   double weight_ball = 0.0, weight_stem = 0.0;
+  BenchWrench bench;
 };
 
 // What an engine says about its contacts after a step.
@@ -38,6 +56,7 @@ struct ContactReport {
   Vec3 friction_ball_W = Vec3::Zero(), friction_stem_W = Vec3::Zero();
   Vec3 p_WC_ball = Vec3::Zero(), p_WC_stem = Vec3::Zero();
   double weight_ball = 0.0, weight_stem = 0.0;  // the positive F_n summed into each point
+  BenchWrench bench;         // the part of the friction the bench applied (add_bench_friction)
   StepMeanForces step_mean;  // set by an adapter whose step's forces are not the report's
 };
 

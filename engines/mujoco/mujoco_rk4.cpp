@@ -63,15 +63,19 @@ void rk4_step_by_stages(const mjModel* m, mjData* d, const std::function<void(in
 }
 
 StepMeanForces rk4_step_mean_forces(const mjModel* m, mjData* d, int body_id,
-                                    const std::function<ContactReport(const mjData*)>& read) {
+                                    const std::function<ContactReport(const mjData*)>& read,
+                                    double& applied_work) {
   StepMeanForces mean;
   Vec3 com0 = Vec3::Zero();
+  double power = 0.0;
   rk4_step_by_stages(m, d, [&](int stage, double weight) {
     const Vec3 com(d->xipos[3 * body_id], d->xipos[3 * body_id + 1], d->xipos[3 * body_id + 2]);
     if (stage == 0) com0 = com;
     add_stage_forces(mean, read(d), weight, com - com0);
+    power += weight * mju_dot(d->qfrc_applied, d->qvel, m->nv);
   });
   finish_stage_forces(mean);
+  applied_work = power * m->opt.timestep;
   return mean;
 }
 

@@ -21,7 +21,10 @@ void rk4_step_by_stages(const mjModel* m, mjData* d, const std::function<void(in
 // points moved with body_id's centre of mass back to the step start's (StepMeanForces). (The last
 // stage's force alone booked the contact's hops on and off the floor while slipping as work no
 // force did: up to 2e-3 E0 a sample on leine_glocker.)
+// applied_work: the work of d->qfrc_applied (the bench's forces, held over the step) as RK4
+// integrates it, h times the b-weighted sum of its power on the stages' velocities.
 StepMeanForces rk4_step_mean_forces(const mjModel* m, mjData* d, int body_id,
-                                    const std::function<ContactReport(const mjData*)>& read);
+                                    const std::function<ContactReport(const mjData*)>& read,
+                                    double& applied_work);
 
 }  // namespace tippe

@@ -227,8 +227,18 @@ void MujocoSimulator::engine_step() {
   // the last: stepped stage by stage (the same arithmetic), the ledger books that sum.
   const bool stepwise = rk4_stepwise_supported(m_);
   StepMeanForces mean;
-  if (stepwise) mean = rk4_step_mean_forces(m_, d_, body_id_, [this](const mjData* d) { return read_contacts(d); });
-  else mj_step(m_, d_);
+  // The bench's forces are a generalized force held over the step, whose rotational part MuJoCo's
+  // free joint takes in the body frame: its work is its power on MuJoCo's own velocities, summed
+  // as the integrator sums the step (see BenchWrench::work).
+  double applied_work = 0.0;
+  if (stepwise) {
+    mean = rk4_step_mean_forces(m_, d_, body_id_, [this](const mjData* d) { return read_contacts(d); }, applied_work);
+  } else {
+    // Euler and implicit update the velocity once with the force held: work = h Q . (u0 + u1) / 2.
+    const double p0 = mju_dot(d_->qfrc_applied, d_->qvel, m_->nv);
+    mj_step(m_, d_);
+    applied_work = 0.5 * (p0 + mju_dot(d_->qfrc_applied, d_->qvel, m_->nv)) * m_->opt.timestep;
+  }
   // apply_force_W acts for one step only.
   mju_zero(d_->qfrc_applied, m_->nv);
   // With RK4 this is the last of the four solves of the step (MuJoCo keeps no total).
@@ -247,6 +257,7 @@ void MujocoSimulator::engine_step() {
   }
   report_ = read_contacts();
   if (stepwise) report_.step_mean = mean;
+  report_.bench.work = applied_work;
 }
 
 BodyState MujocoSimulator::engine_state() const {
