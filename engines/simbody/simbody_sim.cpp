@@ -114,6 +114,12 @@ class LedgerWork : public SimTK::Force::Custom::Implementation {
     zdot[z_ + 1] = p.friction;
   }
   SimTK::ZIndex z() const { return z_; }
+  // Its z's out of the error norm: on a state realized to Model stage, before the integrator's
+  // initialize (which copies the weights with the state).
+  void zero_weights(SimTK::State& s) const {
+    s.updZWeights(forces_)[z_] = 0.0;
+    s.updZWeights(forces_)[z_ + 1] = 0.0;
+  }
 
  private:
   SimTK::SubsystemIndex forces_;
@@ -238,11 +244,7 @@ SimbodySimulator::SimbodySimulator(const Scene& scene)
                                        to_simtk(x0.p_WG)));
   top_.setUToFitVelocity(s, SpatialVec(to_simtk(x0.q_WB * x0.w_B), to_simtk(x0.v_WG)));
   system_.realize(s, Stage::Velocity);
-  if (ledger_) {
-    // The ledger's z's out of the error norm (LedgerWork).
-    s.updZWeights(forces_.getMySubsystemIndex())[ledger_->z()] = 0.0;
-    s.updZWeights(forces_.getMySubsystemIndex())[ledger_->z() + 1] = 0.0;
-  }
+  if (ledger_) ledger_->zero_weights(s);
   make_integrator();
   integ_->initialize(s);
   ledger_last_ = ledger_work(integ_->getState());
@@ -460,6 +462,7 @@ void SimbodySimulator::set_state(const BodyState& x) {
   // they are carried over).
   realizations_before_ += integ_->getNumRealizations();
   iterations_before_ += integ_->getNumIterations();
+  if (ledger_) ledger_->zero_weights(s);
   integ_->initialize(s);
   report_ = read_contacts(integ_->getState());
   ledger_last_ = ledger_work(integ_->getState());
