@@ -42,6 +42,14 @@ struct StepMeanForces {
   BenchWrench bench;
 };
 
+// The contact forces' work over the step as the engine's own integrator integrated their power,
+// where the adapter has it (Simbody: the power as state variables its integrator's stages
+// advance with the motion): the ledger books it as given, with no quadrature of its own.
+struct StepWork {
+  bool set = false;
+  double normal = 0.0, friction = 0.0;  // friction: the tangential forces', the bench's law included
+};
+
 // What an engine says about its contacts after a step.
 struct ContactReport {
   bool ball = false;               // the engine has a contact on the ball geom
@@ -58,6 +66,7 @@ struct ContactReport {
   double weight_ball = 0.0, weight_stem = 0.0;  // the positive F_n summed into each point
   BenchWrench bench;         // the part of the friction the bench applied (add_bench_friction)
   StepMeanForces step_mean;  // set by an adapter whose step's forces are not the report's
+  StepWork step_work;        // set by an adapter whose integrator gives the step's work
 };
 
 // Adds a stage's report (finished) to `mean` with its weight in the step's velocity update, its
@@ -112,9 +121,10 @@ class StepChecks {
   void start(const BodyState& x0);
   // The engine's contact law has a potential (ContactPotential); call before start().
   void set_contact_potential(const ContactPotential& p);
-  // The engine's contact forces are a smooth law read at each step's end (Simbody), not a
-  // solver's impulse over the step: the ledger books their power at the step's end times the
-  // step instead of the impulse's exact work (the force times the step's mean point velocity).
+  // The engine's contact forces are a smooth law read at each step's end (Simbody with an
+  // integrator that cannot book the work itself: ContactReport::step_work), not a solver's
+  // impulse over the step: the ledger books their power at the step's end times the step instead
+  // of the impulse's exact work (the force times the step's mean point velocity).
   void set_smooth_forces() { smooth_forces_ = true; }
   // The engine's contact impulse acts through the contact Jacobian of the step's end state, at the
   // point it reports there (Siconos' Moreau-Jean scheme evaluates its relations at q_n+1), not

@@ -9,10 +9,12 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "analytic/initial_state.h"
@@ -42,9 +44,23 @@ struct SphereSpec {
 };
 
 // The source's viscous law F_t = -k v_C at every sphere that penetrates the floor, each at its
-// lowest point with that material point's horizontal velocity. A force element in Simbody's
-// right-hand side: evaluated at every stage of every step, so the integrator's accuracy covers it
-// (the fixed-step engines can only hold it constant over a step).
+// lowest point p with that material point's horizontal velocity v_C: f(i, p, v_C) for each
+// (the body at X moving with V; one definition for the force, its report and its power).
+template <class F>
+void for_each_viscous(const SimTK::Transform& X, const SimTK::SpatialVec& V, const std::vector<SphereSpec>& spheres, F f) {
+  for (size_t i = 0; i < spheres.size(); ++i) {
+    const SimTK::Vec3 centre = X * spheres[i].centre_B;
+    if (centre[2] - spheres[i].radius >= 0) continue;
+    const SimTK::Vec3 p = centre - SimTK::Vec3(0, 0, spheres[i].radius);
+    SimTK::Vec3 v_C = V[1] + V[0] % (p - X.p());
+    v_C[2] = 0;
+    f(i, p, v_C);
+  }
+}
+
+// The viscous law as a force element in Simbody's right-hand side: evaluated at every stage of
+// every step, so the integrator's accuracy covers it (the fixed-step engines can only hold it
+// constant over a step).
 class ViscousContactForce : public SimTK::Force::Custom::Implementation {
  public:
   ViscousContactForce(const SimTK::MobilizedBody& top, std::vector<SphereSpec> spheres, double k)
@@ -52,15 +68,9 @@ class ViscousContactForce : public SimTK::Force::Custom::Implementation {
   void calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::SpatialVec>& body_forces, SimTK::Vector_<SimTK::Vec3>&,
                  SimTK::Vector&) const override {
     const SimTK::Transform& X = top_.getBodyTransform(s);
-    const SimTK::SpatialVec& V = top_.getBodyVelocity(s);
-    for (const SphereSpec& sp : spheres_) {
-      const SimTK::Vec3 centre = X * sp.centre_B;
-      if (centre[2] - sp.radius >= 0) continue;
-      const SimTK::Vec3 p = centre - SimTK::Vec3(0, 0, sp.radius);
-      SimTK::Vec3 v_C = V[1] + V[0] % (p - X.p());
-      v_C[2] = 0;
+    for_each_viscous(X, top_.getBodyVelocity(s), spheres_, [&](size_t, const SimTK::Vec3& p, const SimTK::Vec3& v_C) {
       top_.applyForceToBodyPoint(s, ~X * p, -k_ * v_C, body_forces);
-    }
+    });
   }
   SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
 
@@ -69,6 +79,58 @@ class ViscousContactForce : public SimTK::Force::Custom::Implementation {
   std::vector<SphereSpec> spheres_;
   double k_;
 };
+
+// The power of the contact forces on the top at a state: the normal forces' and the tangential
+// ones' (Simbody's friction and the bench's viscous law).
+struct ContactPower {
+  double normal = 0.0, friction = 0.0;
+};
+
+// The ledger's work as Simbody integrates it: two continuous state variables z (the normal and
+// the tangential forces' work on the top) whose derivatives are the contact power at every stage
+// of every step, so the integrator's own quadrature, of its own order, books the work of the
+// forces it applied, and the ledger's remainder is Simbody's own energy error. The element
+// applies no force, and its z's carry zero error weight: the explicit integrators' error norm
+// (RK-Merson, RK3, RK2, Euler) is the largest of the q's, the u's and the z's norms, each over its
+// own variables, so their steps and trajectory are bit-identical with and without it (measured:
+// every state column of every sample, the step and right-hand-side counts, on leine_glocker and
+// toy_viscous for 1 s with each). CPodes and Verlet do see the z's (CPodes' norm averages over all
+// of y; Verlet's implicit iteration tests them): CPodes took 15690 steps on leine_glocker's first
+// second instead of 15653 (final energy moved by 2.4e-7 E0), Verlet 8723 instead of 8651 (8.3e-4
+// E0). With those the adapter leaves the element out and the ledger books the power at each
+// step's end (StepChecks::set_smooth_forces), the trajectory untouched.
+class LedgerWork : public SimTK::Force::Custom::Implementation {
+ public:
+  LedgerWork(SimTK::SubsystemIndex forces, std::function<ContactPower(const SimTK::State&)> power)
+      : forces_(forces), power_(std::move(power)) {}
+  void calcForce(const SimTK::State&, SimTK::Vector_<SimTK::SpatialVec>&, SimTK::Vector_<SimTK::Vec3>&,
+                 SimTK::Vector&) const override {}
+  SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
+  void realizeTopology(SimTK::State& s) const override { z_ = s.allocateZ(forces_, SimTK::Vector(2, 0.0)); }
+  void realizeAcceleration(const SimTK::State& s) const override {
+    const ContactPower p = power_(s);
+    SimTK::Vector& zdot = s.updZDot(forces_);
+    zdot[z_] = p.normal;
+    zdot[z_ + 1] = p.friction;
+  }
+  SimTK::ZIndex z() const { return z_; }
+  // Its z's out of the error norm: on a state realized to Model stage, before the integrator's
+  // initialize (which copies the weights with the state).
+  void zero_weights(SimTK::State& s) const {
+    s.updZWeights(forces_)[z_] = 0.0;
+    s.updZWeights(forces_)[z_ + 1] = 0.0;
+  }
+
+ private:
+  SimTK::SubsystemIndex forces_;
+  std::function<ContactPower(const SimTK::State&)> power_;
+  mutable SimTK::ZIndex z_;
+};
+
+// Whether an integrator's step control leaves LedgerWork's zero-weight z's out (LedgerWork).
+bool integrator_keeps_z_out_of_its_steps(const std::string& integrator) {
+  return integrator != "cpodes" && integrator != "verlet";
+}
 
 class SimbodySimulator : public CheckedSimulator {
  public:
@@ -89,6 +151,9 @@ class SimbodySimulator : public CheckedSimulator {
  private:
   BodyState read_state(const SimTK::State& s) const;
   ContactReport read_contacts(const SimTK::State& s) const;
+  ContactPower contact_power(const SimTK::State& s) const;
+  // The ledger's work so far (normal, tangential) as LedgerWork's z's hold it.
+  std::pair<double, double> ledger_work(const SimTK::State& s) const;
   void after_step();
   void make_integrator();
   void make_notes();
@@ -112,6 +177,8 @@ class SimbodySimulator : public CheckedSimulator {
   long long realizations_before_ = 0, iterations_before_ = 0;  // of integrators replaced by set_state
   ContactReport report_;
   std::vector<SphereSpec> spheres_;  // ball, then stem: for the bench's viscous force in reports
+  const LedgerWork* ledger_ = nullptr;  // owned by forces_
+  std::pair<double, double> ledger_last_{0.0, 0.0};  // its z's at the last step's end
 };
 
 SimbodySimulator::SimbodySimulator(const Scene& scene)
@@ -162,6 +229,11 @@ SimbodySimulator::SimbodySimulator(const Scene& scene)
   top_ = MobilizedBody::Free(matter_.Ground(), Transform(), body, Transform());
   if (friction_.bench_viscous) Force::Custom(forces_, new ViscousContactForce(top_, spheres, scene.contact.k));
   spheres_ = spheres;
+  if (integrator_keeps_z_out_of_its_steps(settings_.integrator)) {
+    auto* ledger = new LedgerWork(forces_.getMySubsystemIndex(), [this](const SimTK::State& st) { return contact_power(st); });
+    Force::Custom(forces_, ledger);
+    ledger_ = ledger;
+  }
 
   system_.realizeTopology();
   ball_surface_ = tracker_.getContactSurfaceIndex(top_, ball);
@@ -172,8 +244,10 @@ SimbodySimulator::SimbodySimulator(const Scene& scene)
                                        to_simtk(x0.p_WG)));
   top_.setUToFitVelocity(s, SpatialVec(to_simtk(x0.q_WB * x0.w_B), to_simtk(x0.v_WG)));
   system_.realize(s, Stage::Velocity);
+  if (ledger_) ledger_->zero_weights(s);
   make_integrator();
   integ_->initialize(s);
+  ledger_last_ = ledger_work(integ_->getState());
 
   // Hertz's law F_n = (4/3) E_eff sqrt(R_s) x^(3/2) without its Hunt-Crossley damping: the
   // elastic energy of the energy ledger (simbody_settings.h gives E_eff).
@@ -183,7 +257,7 @@ SimbodySimulator::SimbodySimulator(const Scene& scene)
   hertz.k_stem = m.stem ? 4.0 / 3.0 * E_eff * std::sqrt(m.r) : 0.0;
   hertz.exponent = 1.5;
   checks_.set_contact_potential(hertz);
-  checks_.set_smooth_forces();
+  if (!ledger_) checks_.set_smooth_forces();
   checks_.start(read_state(integ_->getState()));
   report_ = read_contacts(integ_->getState());
   make_notes();
@@ -299,24 +373,45 @@ ContactReport SimbodySimulator::read_contacts(const SimTK::State& s) const {
     add_surface_force(r, on_stem, f_n, Vec3(f_W[0], f_W[1], 0.0), to_eigen(f.getContactPoint()));
   }
   finish_surface_points(r);
-  if (friction_.bench_viscous) {
-    // The bench's viscous force as ViscousContactForce evaluates it at this state.
-    const SimTK::Transform& X = top_.getBodyTransform(s);
-    const SimTK::SpatialVec& V = top_.getBodyVelocity(s);
-    for (size_t i = 0; i < spheres_.size(); ++i) {
-      const SimTK::Vec3 centre = X * spheres_[i].centre_B;
-      if (centre[2] - spheres_[i].radius >= 0) continue;
-      const SimTK::Vec3 p = centre - SimTK::Vec3(0, 0, spheres_[i].radius);
-      SimTK::Vec3 v_C = V[1] + V[0] % (p - X.p());
-      v_C[2] = 0;
-      (i == 1 ? r.friction_stem_W : r.friction_ball_W) += to_eigen(-scene_.contact.k * v_C);
-    }
-  }
+  if (friction_.bench_viscous)  // the bench's viscous force as ViscousContactForce evaluates it at this state
+    for_each_viscous(top_.getBodyTransform(s), top_.getBodyVelocity(s), spheres_,
+                     [&](size_t i, const SimTK::Vec3&, const SimTK::Vec3& v_C) {
+                       (i == 1 ? r.friction_stem_W : r.friction_ball_W) += to_eigen(-scene_.contact.k * v_C);
+                     });
   if (r.normal_force > 0) {
     r.point_valid = true;
     r.p_WC = moment / r.normal_force;
   }
   return r;
+}
+
+ContactPower SimbodySimulator::contact_power(const SimTK::State& s) const {
+  ContactPower p;
+  const SimTK::Transform& X = top_.getBodyTransform(s);
+  const SimTK::SpatialVec& V = top_.getBodyVelocity(s);
+  const int n = contact_.getNumContactForces(s);
+  const SimTK::ContactSnapshot& active = tracker_.getActiveContacts(s);
+  for (int i = 0; i < n; ++i) {
+    const SimTK::ContactForce& f = contact_.getContactForce(s, i);
+    const SimTK::Contact& c = active.getContactById(f.getContactId());
+    const bool top_second = c.getSurface2() == ball_surface_ || (stem_surface_.isValid() && c.getSurface2() == stem_surface_);
+    // The force and moment on the top at the contact point, as Simbody applies them there.
+    const SimTK::SpatialVec F = (top_second ? 1.0 : -1.0) * f.getForceOnSurface2();
+    const SimTK::Vec3 v_C = V[1] + V[0] % (f.getContactPoint() - X.p());
+    p.normal += F[1][2] * v_C[2];
+    p.friction += F[1][0] * v_C[0] + F[1][1] * v_C[1] + ~F[0] * V[0];
+  }
+  if (friction_.bench_viscous)  // ViscousContactForce's F = -k v_C at its point: power -k |v_C|^2
+    for_each_viscous(X, V, spheres_, [&](size_t, const SimTK::Vec3&, const SimTK::Vec3& v_C) {
+      p.friction += -scene_.contact.k * (~v_C * v_C);
+    });
+  return p;
+}
+
+std::pair<double, double> SimbodySimulator::ledger_work(const SimTK::State& s) const {
+  if (!ledger_) return {0.0, 0.0};
+  const SimTK::Vector& z = s.getZ(forces_.getMySubsystemIndex());
+  return {z[ledger_->z()], z[ledger_->z() + 1]};
 }
 
 void SimbodySimulator::advance_to(double t) {
@@ -345,6 +440,11 @@ void SimbodySimulator::after_step() {
   ++work_.steps;
   const SimTK::State& s = integ_->getState();
   report_ = read_contacts(s);
+  const std::pair<double, double> w = ledger_work(s);
+  report_.step_work.set = ledger_ != nullptr;
+  report_.step_work.normal = w.first - ledger_last_.first;
+  report_.step_work.friction = w.second - ledger_last_.second;
+  ledger_last_ = w;
   checks_.after_step(s.getTime(), read_state(s), report_);
 }
 
@@ -362,8 +462,10 @@ void SimbodySimulator::set_state(const BodyState& x) {
   // they are carried over).
   realizations_before_ += integ_->getNumRealizations();
   iterations_before_ += integ_->getNumIterations();
+  if (ledger_) ledger_->zero_weights(s);
   integ_->initialize(s);
   report_ = read_contacts(integ_->getState());
+  ledger_last_ = ledger_work(integ_->getState());
   checks_.restart(read_state(integ_->getState()));
 }
 
