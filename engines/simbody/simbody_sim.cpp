@@ -62,6 +62,10 @@ class SimbodySimulator : public CheckedSimulator {
  private:
   BodyState read_state(const SimTK::State& s) const;
   ContactReport read_contacts(const SimTK::State& s) const;
+  // f(force, its spatial force on the top at its contact point, on the stem) for each contact
+  // force Simbody reports at s.
+  template <class F>
+  void for_each_contact_force(const SimTK::State& s, F f) const;
   ContactPower contact_power(const SimTK::State& s) const;
   // The ledger's work so far (normal, tangential) as LedgerWork's z's hold it.
   std::pair<double, double> ledger_work(const SimTK::State& s) const;
@@ -261,28 +265,33 @@ BodyState SimbodySimulator::read_state(const SimTK::State& s) const {
   return x;
 }
 
-ContactReport SimbodySimulator::read_contacts(const SimTK::State& s) const {
-  ContactReport r;
-  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+template <class F>
+void SimbodySimulator::for_each_contact_force(const SimTK::State& s, F f) const {
   const int n = contact_.getNumContactForces(s);
   const SimTK::ContactSnapshot& active = tracker_.getActiveContacts(s);
   for (int i = 0; i < n; ++i) {
-    const SimTK::ContactForce& f = contact_.getContactForce(s, i);
-    const SimTK::Contact& c = active.getContactById(f.getContactId());
+    const SimTK::ContactForce& cf = contact_.getContactForce(s, i);
+    const SimTK::Contact& c = active.getContactById(cf.getContactId());
     // The force on the top: on surface 2 as reported, or its negative when the top is surface 1.
     const bool top_second = c.getSurface2() == ball_surface_ || (stem_surface_.isValid() && c.getSurface2() == stem_surface_);
     const SimTK::ContactSurfaceIndex mine = top_second ? c.getSurface2() : c.getSurface1();
-    const double f_n = (top_second ? 1.0 : -1.0) * f.getForceOnSurface2()[1][2];
-    const bool on_stem = stem_surface_.isValid() && mine == stem_surface_;
+    f(cf, SimTK::SpatialVec((top_second ? 1.0 : -1.0) * cf.getForceOnSurface2()), stem_surface_.isValid() && mine == stem_surface_);
+  }
+}
+
+ContactReport SimbodySimulator::read_contacts(const SimTK::State& s) const {
+  ContactReport r;
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  for_each_contact_force(s, [&](const SimTK::ContactForce& f, const SimTK::SpatialVec& F, bool on_stem) {
+    const double f_n = F[1][2];
     (on_stem ? r.stem : r.ball) = true;
     r.normal_force += f_n;
     (on_stem ? r.normal_force_stem : r.normal_force_ball) += f_n;
     moment += f_n * to_eigen(f.getContactPoint());
     // The compliant force law's force at the state (Ground frame = lab): its horizontal part is
     // the friction force.
-    const SimTK::Vec3 f_W = (top_second ? 1.0 : -1.0) * f.getForceOnSurface2()[1];
-    add_surface_force(r, on_stem, f_n, Vec3(f_W[0], f_W[1], 0.0), to_eigen(f.getContactPoint()));
-  }
+    add_surface_force(r, on_stem, f_n, Vec3(F[1][0], F[1][1], 0.0), to_eigen(f.getContactPoint()));
+  });
   finish_surface_points(r);
   if (friction_.bench_viscous)  // the bench's viscous force as ViscousContactForce evaluates it at this state
     for_each_viscous(top_.getBodyTransform(s), top_.getBodyVelocity(s), spheres_,
@@ -300,18 +309,11 @@ ContactPower SimbodySimulator::contact_power(const SimTK::State& s) const {
   ContactPower p;
   const SimTK::Transform& X = top_.getBodyTransform(s);
   const SimTK::SpatialVec& V = top_.getBodyVelocity(s);
-  const int n = contact_.getNumContactForces(s);
-  const SimTK::ContactSnapshot& active = tracker_.getActiveContacts(s);
-  for (int i = 0; i < n; ++i) {
-    const SimTK::ContactForce& f = contact_.getContactForce(s, i);
-    const SimTK::Contact& c = active.getContactById(f.getContactId());
-    const bool top_second = c.getSurface2() == ball_surface_ || (stem_surface_.isValid() && c.getSurface2() == stem_surface_);
-    // The force and moment on the top at the contact point, as Simbody applies them there.
-    const SimTK::SpatialVec F = (top_second ? 1.0 : -1.0) * f.getForceOnSurface2();
+  for_each_contact_force(s, [&](const SimTK::ContactForce& f, const SimTK::SpatialVec& F, bool) {
     const SimTK::Vec3 v_C = V[1] + V[0] % (f.getContactPoint() - X.p());
     p.normal += F[1][2] * v_C[2];
     p.friction += F[1][0] * v_C[0] + F[1][1] * v_C[1] + ~F[0] * V[0];
-  }
+  });
   if (friction_.bench_viscous)  // ViscousContactForce's F = -k v_C at its point: power -k |v_C|^2
     for_each_viscous(X, V, spheres_, [&](size_t, const SimTK::Vec3&, const SimTK::Vec3& v_C) {
       p.friction += -scene_.contact.k * (~v_C * v_C);
