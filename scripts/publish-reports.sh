@@ -14,6 +14,7 @@ fi
 jobs="${JOBS:-$(nproc 2>/dev/null || echo 2)}"
 # REPORTS_DIR=DIR writes elsewhere (e.g. to try the script without touching reports/).
 reports="${REPORTS_DIR:-$root/reports}"
+source "$root/scripts/publish-guard.sh" publish-reports
 # Trajectories and plot data stay in a scratch directory: the published pages need only the
 # records, the SVGs and the pages themselves.
 work="$(mktemp -d "${TMPDIR:-/tmp}/tippe-publish.XXXXXX")"

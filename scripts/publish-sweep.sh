@@ -16,6 +16,7 @@ jobs="${JOBS:-$(nproc 2>/dev/null || echo 2)}"
 # elsewhere than reports/.
 sweep="${SWEEP:-harness/sweeps/default.toml}"
 reports="${REPORTS_DIR:-$root/reports}"
+source "$root/scripts/publish-guard.sh" publish-sweep
 name="sweep-$(basename "$sweep" .toml)"
 # The sweep runs in a scratch directory (fresh: what is published comes from this build alone).
 # SWEEP_OUT=DIR runs it there instead and keeps it, so that an interrupted publish resumes where
