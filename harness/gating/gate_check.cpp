@@ -44,6 +44,9 @@ std::string absent_reason(const std::string& metric, const Metrics& m) {
   if (metric == "numerical_energy_max" || metric == "numerical_energy_final" || metric == "friction_work" ||
       metric == "normal_work" || metric == "elastic_energy_max")
     return "the energy ledger: not available for this engine, or a record written before the ledger";
+  if (metric == "friction_work_reference_sticks")
+    return "the reference's contact never sticks in the compared window, the engine has no ledger, or a record "
+           "written before this metric";
   return "not computed";
 }
 
@@ -145,7 +148,9 @@ bool windowed_metric(const std::string& metric) {
                                               "com_path_max_error",     "latitude_rms_error",     "compared_until",
                                               // the event alignment leaves out events after the window
                                               "event_time_max_error",   "events_missing",         "events_extra",
-                                              "first_wrong_event"};
+                                              "first_wrong_event",
+                                              // from the reference's stick events inside the window
+                                              "friction_work_reference_sticks"};
   return names.count(metric) > 0;
 }
 

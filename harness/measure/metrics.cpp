@@ -6,6 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <set>
+#include <string>
+#include <vector>
 #include "harness/io/json_fields.h"
 #include "harness/measure/event_alignment.h"
 
@@ -192,6 +195,44 @@ EnergyGains energy_gains(const Trajectory& tr, double allowance, EnergyGainRule 
   return g;
 }
 
+std::optional<double> friction_work_where_reference_sticks(const std::vector<Event>& reference_events,
+                                                          const Trajectory& engine, double until) {
+  // What ends a stick: the slip starting again, or the contact set changing under it.
+  static const std::set<std::string> ends = {"slip",        "lift",   "flight",      "touchdown",
+                                             "two_contact", "impact", "stem_contact", "switch"};
+  std::vector<Event> events = reference_events;
+  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.time < b.time; });
+  std::vector<std::pair<double, double>> sticks;
+  std::optional<double> from;
+  for (const Event& e : events) {
+    if (e.time > until) break;
+    if (e.name == "stick") {
+      if (!from) from = e.time;
+    } else if (from && ends.count(e.name)) {
+      sticks.emplace_back(*from, e.time);
+      from.reset();
+    }
+  }
+  if (from) sticks.emplace_back(*from, until);
+  if (sticks.empty() || engine.t.size() < 2 || engine.friction_work.size() != engine.t.size()) return std::nullopt;
+  // Each sample interval's work in the share of it that lies in a stick (linear within the
+  // interval: the stick's ends fall between samples).
+  double work = 0.0;
+  size_t j = 0;
+  for (size_t k = 1; k < engine.t.size(); ++k) {
+    const double a = engine.t[k - 1], b = engine.t[k];
+    while (j < sticks.size() && sticks[j].second <= a) ++j;
+    if (j == sticks.size()) break;
+    if (!(b > a)) continue;
+    double inside = 0.0;
+    for (size_t i = j; i < sticks.size() && sticks[i].first < b; ++i)
+      inside += std::max(0.0, std::min(b, sticks[i].second) - std::max(a, sticks[i].first));
+    if (inside > 0) work += (engine.friction_work[k] - engine.friction_work[k - 1]) * std::min(1.0, inside / (b - a));
+  }
+  if (!std::isfinite(work)) return std::nullopt;
+  return work;
+}
+
 Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, const RunRecord& engine,
                      const Trajectory& engine_traj, const Scene& scene, std::optional<double> converged_until) {
   Metrics m;
@@ -295,6 +336,9 @@ Metrics compare_runs(const RunRecord& reference, const Trajectory& ref_traj, con
   };
   m.normal_work = ledger(engine.normal_work);
   m.friction_work = ledger(engine.friction_work);
+  if (const auto w = friction_work_where_reference_sticks(
+          reference.events, engine_traj, converged_until ? *converged_until : std::numeric_limits<double>::infinity()))
+    m.friction_work_reference_sticks = ledger(*w);
   m.drilling_work = ledger(engine.drilling_work);
   m.impact_energy = ledger(engine.impact_energy);
   m.elastic_energy_max = ledger(engine.elastic_energy_max);

@@ -104,6 +104,14 @@ bool has_elastic_store(const Trajectory& trajectory);
 // The series the rule is applied to, one value per sample (E + U - U0 under Stored, E0 + C(t)
 // under Ledger, E under Total).
 std::vector<double> energy_counted(const Trajectory& trajectory, EnergyGainRule rule);
+// The engine's friction work while the reference's contact sticks: from each of the reference's
+// "stick" events to its next "slip" or change of contact (lift, flight, touchdown, impact, two
+// contacts, stem contact, a switch of surface), cut at `until` (the reference's converged window);
+// the engine's friction work summed over its sample intervals inside one. Work the reference's
+// contact does not do there: the creep or slip of a contact that should roll. Null where the
+// reference never sticks before `until`, or the engine's trajectory has no friction work.
+std::optional<double> friction_work_where_reference_sticks(const std::vector<Event>& reference_events,
+                                                          const Trajectory& engine, double until);
 
 // The depth resolution of the allowance, a fraction of R (see above).
 inline constexpr double kContactDepthResolution = 1e-4;

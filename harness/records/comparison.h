@@ -42,6 +42,7 @@ struct Metrics {
   // The engine's energy ledger at the end of its run (RunRecord), / |E0| of the engine's run;
   // absent (null) where the engine cannot give the term and in records written before it.
   std::optional<double> normal_work, friction_work, drilling_work, impact_energy;
+  std::optional<double> friction_work_reference_sticks;  // while the reference's contact sticks
   std::optional<double> elastic_energy_max, numerical_energy_max, numerical_energy_final;
   double contact_path_rms_error = 0, contact_path_max_error = 0;  // floor contact path, / R
   double com_path_rms_error = 0, com_path_max_error = 0;          // path of G (x, y), / R
@@ -129,6 +130,13 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Metrics>> visit(R& m, V&
           "null: not available")
         .since(),
     m.friction_work);
+  v(Field("friction_work_reference_sticks",
+          "energy ledger (docs/energy-ledger.md): the engine's friction work while the reference's contact sticks "
+          "(from the reference's stick event to its next slip or change of contact, in the compared window), / |E0| "
+          "of the engine's run: the creep or slip of a contact that should roll (the reference's own is 0); null: the "
+          "reference never sticks there, the ledger is not available, or a record written before it")
+        .since(),
+    m.friction_work_reference_sticks);
   v(Field("normal_work",
           "energy ledger (docs/energy-ledger.md): work of the normal forces on the top, / |E0| of the engine's run; "
           "null: not available")

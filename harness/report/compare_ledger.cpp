@@ -87,6 +87,11 @@ std::string ledger_cause_sentence(const json& c, const json& e) {
   if (has_number(s, "friction_work") && has_number(ref, "friction_work"))
     out += " (friction work " + rel(s, "friction_work") + " E0 against the reference's " + rel(ref, "friction_work") +
            " E0 over its whole run to t = " + fmt(num(ref, "final_time"), "%.6g") + ")";
+  // The creep or slip of a contact the reference keeps rolling, from the reference's own stick
+  // events (over the compared window, not only to the inversion).
+  if (e.contains("metrics") && has_number(e.at("metrics"), "friction_work_reference_sticks"))
+    out += "; while the reference's contact sticks (in the compared window) the engine's friction did " +
+           fmt(num(e.at("metrics"), "friction_work_reference_sticks"), "%.3g") + " E0 of work, the reference's none";
   const json na = s.value("ledger_not_available", json::array());
   if (!na.empty()) {
     std::string list;

@@ -154,7 +154,8 @@ Table detail_table(const json& c) {
   Table t;
   t.header = {"engine",         "compared to t",   "reference converged to t", "tilt max (rad)",    "E final/E0",      "E gain events",
               "max gain (/E0)", "contact path max (/R)", "G path RMS (/R)", "G path max (/R)", "latitude RMS (rad)",
-              "Jellett ball",   "Jellett stem",    "surface switches",  "wall s",          "real-time factor"};
+              "Jellett ball",   "Jellett stem",    "surface switches",  "friction work while the reference sticks (/E0)",
+              "wall s",         "real-time factor"};
   for (const json& e : c.at("engines")) {
     const json& m = e.at("metrics");
     auto cell = [&](const char* key, const char* spec = "%.3g") {
@@ -179,6 +180,8 @@ Table detail_table(const json& c) {
                       cell("jellett_drift_ball", "%.2g"),
                       cell("jellett_drift_stem", "%.2g"),
                       {std::to_string(switch_count(e.at("summary")))},
+                      {has_number(m, "friction_work_reference_sticks") ? fmt(num(m, "friction_work_reference_sticks"), "%.3g")
+                                                                       : std::string("-")},
                       cell("wall_seconds"),
                       cell("real_time_factor")});
   }

@@ -2,10 +2,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
+#include <limits>
+#include <utility>
+#include <vector>
 #include <regex>
 #include <string>
 
 #include "harness/measure/compare.h"
+#include "harness/measure/metrics.h"
 #include "harness/records/records.h"
 #include "harness/report/report.h"
 #include "harness/io/scene_io.h"
@@ -201,6 +206,62 @@ TEST(Metrics, CostRatioGuardsAZeroReference) {
   EXPECT_EQ(compare_runs(make_record("analytic", {}, {}, 0.0), tr, make_record("ode", {}, {}, 2.0), tr, scene)
                 .cost_ratio,
             0.0);
+}
+
+// An engine whose friction works at a steady rate, -0.1 a unit of time, sampled every 0.01.
+Trajectory steady_friction_work() {
+  Trajectory tr = make_traj(201, 0.01, Columns{});
+  tr.friction_work.clear();
+  for (const double t : tr.t) tr.friction_work.push_back(-0.1 * t);
+  return tr;
+}
+
+std::vector<Event> reference_events(std::initializer_list<std::pair<const char*, double>> list) {
+  std::vector<Event> events;
+  for (const auto& [name, time] : list) events.push_back({name, time, "", 0.0});
+  return events;
+}
+
+TEST(Metrics, FrictionWorkWhileTheReferenceSticks) {
+  const Trajectory eng = steady_friction_work();
+  const double inf = std::numeric_limits<double>::infinity();
+  // Sticking over [0.5, 1.0] and from 1.5 on (to the engine's end, 2.0): 0.5 + 0.5 of time. The
+  // work is a sum of 100 differences of numbers below 0.2: a few ulps of 0.1.
+  const auto both = friction_work_where_reference_sticks(
+      reference_events({{"inversion", 0.2}, {"stick", 0.5}, {"slip", 1.0}, {"stick", 1.5}}), eng, inf);
+  ASSERT_TRUE(both.has_value());
+  EXPECT_NEAR(*both, -0.1, 1e-12);
+  // Cut at the reference's converged window.
+  const auto cut = friction_work_where_reference_sticks(
+      reference_events({{"stick", 0.5}, {"slip", 1.0}, {"stick", 1.5}}), eng, 1.75);
+  ASSERT_TRUE(cut.has_value());
+  EXPECT_NEAR(*cut, -0.075, 1e-12);
+  // A change of contact ends a stick as a slip does; events out of order are put in order.
+  const auto touch = friction_work_where_reference_sticks(
+      reference_events({{"two_contact", 0.7}, {"stick", 0.5}}), eng, inf);
+  ASSERT_TRUE(touch.has_value());
+  EXPECT_NEAR(*touch, -0.02, 1e-12);
+  // No stick in the window, or no friction work in the engine's trajectory: no value.
+  EXPECT_FALSE(friction_work_where_reference_sticks(reference_events({{"slip", 0.5}}), eng, inf).has_value());
+  EXPECT_FALSE(friction_work_where_reference_sticks(reference_events({{"stick", 1.9}}), eng, 1.5).has_value());
+  Trajectory no_ledger = eng;
+  no_ledger.friction_work.clear();
+  EXPECT_FALSE(friction_work_where_reference_sticks(reference_events({{"stick", 0.5}}), no_ledger, inf).has_value());
+}
+
+TEST(Metrics, FrictionWorkWhileTheReferenceSticksIsOverTheEnginesInitialEnergy) {
+  const Scene scene = test_scene();
+  const Trajectory ref = make_traj(201, 0.01, Columns{});
+  RunRecord reference = make_record("analytic", std::nullopt, std::nullopt);
+  reference.events = reference_events({{"stick", 1.0}});
+  RunRecord engine = make_record("ode", std::nullopt, std::nullopt);
+  engine.energy_initial = -4.0;  // the scale is |E0|
+  const Metrics m = compare_runs(reference, ref, engine, steady_friction_work(), scene);
+  ASSERT_TRUE(m.friction_work_reference_sticks.has_value());
+  EXPECT_NEAR(*m.friction_work_reference_sticks, -0.1 / 4.0, 1e-12);
+  // The reference never sticks: null.
+  reference.events.clear();
+  EXPECT_FALSE(compare_runs(reference, ref, engine, steady_friction_work(), scene).friction_work_reference_sticks);
 }
 
 TEST(Metrics, JsonRoundTrip) {
