@@ -16,7 +16,7 @@ namespace tippe {
 // The ledger books this part at the bench's point, not at the engine's contact point: a soft
 // contact's point lies inside the penetration, and the two points' velocities differ by the spin
 // times that depth (MuJoCo's two-contact slide on toy_viscous booked 3e-4 E0 of work that no
-// force did, the same at every step: docs/findings/energy-ledger-per-run.md).
+// force did, the same at every step: docs/findings/energy-gain-rule.md, "The bench's own force").
 struct BenchWrench {
   Vec3 f_ball_W = Vec3::Zero(), f_stem_W = Vec3::Zero();
   Vec3 m_ball_W = Vec3::Zero(), m_stem_W = Vec3::Zero();
