@@ -10,8 +10,9 @@ publish_guard() {
     exit 2
   fi
   head="$(git -C "$root" rev-parse --short=12 HEAD 2>/dev/null || true)"
-  # `tippe --version` names the commit its build was configured at: "tippe X (commit C, ...)".
-  built="$("$tippe" --version 2>/dev/null | sed -n '1s/.*(commit \([0-9a-f]*\).*/\1/p')"
+  # `tippe --version` names the commit its build was made from: "tippe X (commit C, ...)", C
+  # ending in "-dirty" when the tree had changes then (cmake/provenance.cmake).
+  built="$("$tippe" --version 2>/dev/null | sed -n '1s/.*(commit \([0-9a-z-]*\).*/\1/p')"
   if [ -z "$head" ] || [ "$built" != "$head" ]; then
     echo "$name: $tippe was built at commit ${built:-unknown}, HEAD is ${head:-unknown}: rebuild it (cmake --build ${tippe%/tippe} --target tippe) so its records name the commit that made them" >&2
     exit 2

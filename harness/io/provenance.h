@@ -6,6 +6,8 @@
 namespace tippe {
 
 struct BuildInfo {
+  // The commit the build was made from (12 hex digits), "-dirty" appended when the tree's tracked
+  // files differed from it at the build, "unknown" outside a git checkout.
   std::string git_commit;
   std::string compiler;
   std::string cxx_flags;

@@ -37,7 +37,7 @@ struct Provenance {
 };
 template <class R, class V>
 std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Provenance>> visit(R& p, V& v) {
-  v(Field("git_commit"), p.git_commit);
+  v(Field("git_commit", "the commit the build was made from; \"-dirty\" appended when its tracked files had changes"), p.git_commit);
   v(Field("compiler"), p.compiler);
   v(Field("cxx_flags"), p.cxx_flags);
   v(Field("date", "UTC, ISO 8601, when the run started"), p.date);

@@ -22,9 +22,13 @@
 namespace tippe::fixtures {
 
 // The source tree, the build tree and the `tippe` binary the tests run.
-inline const std::string kSourceDir = TIPPE_SOURCE_DIR;
-inline const std::string kTippeBinary = std::string(TIPPE_BINARY_DIR) + "/tippe";
-inline const std::string kScenesDir = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/";
+// `static`, one copy per program, and not `inline`: an inline variable's initialization is only
+// partially ordered, and under clang with the precompiled header (the sanitized build) a test
+// file's own constants built from these (`kSource + "/harness/sweeps/smoke.toml"`) were
+// initialized first, from an empty string. The support headers' other string constants follow.
+static const std::string kSourceDir = TIPPE_SOURCE_DIR;
+static const std::string kTippeBinary = std::string(TIPPE_BINARY_DIR) + "/tippe";
+static const std::string kScenesDir = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/";
 
 // The source's dimensionless top (REFERENCE_VALUES.md): g = R = M = 1, r = 0.25, l = 1.2, h = 0.9,
 // d = 0.3, A = 0.4, C = 0.45 given directly, tilt 0.1 rad, spin 5, 2 time units sampled every 0.01.

@@ -11,7 +11,7 @@
 namespace tippe::fixtures {
 
 // The scene the tests' gate files name.
-inline const std::string kGateScene = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/source_dimensionless.toml";
+static const std::string kGateScene = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/source_dimensionless.toml";
 
 inline Check fixture_check() {
   Check c;

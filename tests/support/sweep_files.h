@@ -15,8 +15,8 @@ inline std::filesystem::path write_sweep(const std::filesystem::path& dir, const
   return p;
 }
 
-inline const std::string kGoodHead = "repeats = 1\nduration = 0.5\nscenes = [\"" TIPPE_SOURCE_DIR "/harness/scenes/source_dimensionless.toml\"]\n";
-inline const std::string kGoodSetup =
+static const std::string kGoodHead = "repeats = 1\nduration = 0.5\nscenes = [\"" TIPPE_SOURCE_DIR "/harness/scenes/source_dimensionless.toml\"]\n";
+static const std::string kGoodSetup =
     "[[setup]]\nname = \"ode\"\nengine = \"ode\"\nladder.key = \"engines.ode.timestep\"\n"
     "ladder.values = [1e-3, 5e-4]\n";
 

@@ -69,7 +69,7 @@ inline void expect_same_records(const std::filesystem::path& expected_dir, const
 
 // ---- sweeps the tests of shards and ranks share ------------------------------------------------
 
-inline const std::string kSmoke = TIPPE_SOURCE_DIR "/harness/sweeps/smoke.toml";
+static const std::string kSmoke = TIPPE_SOURCE_DIR "/harness/sweeps/smoke.toml";
 
 // One local run of the smoke sweep, shared by the tests that compare against it.
 inline const std::filesystem::path& local_smoke() {
