@@ -88,9 +88,9 @@ struct EnergyGains {
 // 4.0e-5 E0 when first counted) and 30 of its 93 points safe in the reference's regime stop
 // being so, answers that agree with the reference (inversion within 1 %) among them, the
 // reference's own integrators at rtol 1e-3 too; DART and MuJoCo's Euler integrator have no safe
-// step left on toy_viscous,
-// Bullet's softest safe step on source_dimensionless goes from 3e-3 to 3e-5. "Safe" is "gives the
-// reference's answer"; a class that refuses answers which agree would answer another question.
+// step left on toy_viscous, Bullet's softest safe step on source_dimensionless goes from 3e-3 to
+// 3e-5. "Safe" is "gives the reference's answer"; a class that refuses answers which agree would
+// answer another question.
 // The class keeps what the trajectory shows (E + U rising where only friction and damping act);
 // the numerical energy is reported beside it (numerical_energy_max, the verdict's ledger
 // sentence) and bounded where a user asks for it (a gate's [check.max] numerical_energy_max).
