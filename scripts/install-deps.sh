@@ -9,6 +9,7 @@ pkgs=(cmake g++ make pkg-config libeigen3-dev libbullet-dev libode-dev libmujoco
       python3-setuptools python3-wheel python3-venv python3-pip  # pip install --no-build-isolation . (docs/python.md)
       python3-jsonschema  # the records against schemas/ (Library.RecordsMatchSchemas)
       libdart-dev libdart-external-ikfast-dev  # DART 6.12 (engines/dart/dart_sim.cpp); dart/dart.hpp needs ikfast's headers
+      libdart-collision-bullet-dev  # DART's Bullet backend (engines.dart.collision_detector = "bullet"), in the DART module only
       libsimbody-dev  # Simbody 3.7 (engines/simbody/): the error-controlled, compliant-contact engine
       libsiconos-kernel-dev libsiconos-numerics-dev  # Siconos 4.4 (engines/siconos/): nonsmooth Moreau-Jean time-stepping; not its mechanics library (single-precision Bullet)
       chromium  # headless, for the check of every published page (tests/harness/report/test_published_pages.cpp)

@@ -1,15 +1,18 @@
 // DART 6.12 adapter: one FreeJoint body at G carrying a ball and a stem shape on a floor, stepped by the shared fixed-step loop.
 //
-// Collision backends: DART's own detector ("dart") and FCL ("fcl", "fcl_mesh"). DART's Bullet
-// backend (libdart-collision-bullet) is deliberately not used: it links Debian's
-// single-precision Bullet (libBulletCollision.so), while this binary links the double-precision
-// build (bullet-float64) for the Bullet adapter; both export the same C++ symbols, so loading
-// both into one process is an ODR violation (whichever definition the loader binds first is used
-// by both, with the other's struct layouts).
+// Collision backends: DART's own detector ("dart"), FCL ("fcl", "fcl_mesh") and Bullet ("bullet",
+// DART's libdart-collision-bullet). That last links Debian's single-precision Bullet
+// (libBulletCollision.so), the Bullet adapter the double-precision build (bullet-float64); both
+// export the same C++ symbols. Each adapter is a module opened with RTLD_LOCAL, so each binds its
+// own Bullet and both run in one process (tests/engines/test_dart.cpp); a build that links every
+// engine into one binary cannot, and refuses "bullet" (TIPPE_DART_BULLET_BACKEND unset).
 #include <dart/collision/CollisionGroup.hpp>
 #include <dart/collision/CollisionObject.hpp>
 #include <dart/collision/CollisionResult.hpp>
 #include <dart/collision/dart/DARTCollisionDetector.hpp>
+#if defined(TIPPE_DART_BULLET_BACKEND)
+#include <dart/collision/bullet/BulletCollisionDetector.hpp>
+#endif
 #include <dart/collision/fcl/FCLCollisionDetector.hpp>
 #include <dart/config.hpp>
 #include <dart/constraint/BoxedLcpConstraintSolver.hpp>
@@ -111,6 +114,15 @@ DartSimulator::DartSimulator(const Scene& scene)
   auto* solver = world_->getConstraintSolver();
   if (settings_.collision_detector == "dart") {
     solver->setCollisionDetector(collision::DARTCollisionDetector::create());
+  } else if (settings_.collision_detector == "bullet") {
+#if defined(TIPPE_DART_BULLET_BACKEND)
+    solver->setCollisionDetector(collision::BulletCollisionDetector::create());
+#else
+    throw std::invalid_argument(
+        "dart: collision_detector = \"bullet\" needs the engines as modules (TIPPE_ENGINE_MODULES=ON): DART's Bullet "
+        "backend links single-precision Bullet, which cannot share one binary with the Bullet adapter's double-precision "
+        "build");
+#endif
   } else {
     auto fcl = collision::FCLCollisionDetector::create();
     fcl->setPrimitiveShapeType(settings_.collision_detector == "fcl" ? collision::FCLCollisionDetector::PRIMITIVE
@@ -123,14 +135,14 @@ DartSimulator::DartSimulator(const Scene& scene)
 
   const double mu = native_mu(settings_.rolling_mu);
 
-  // The floor: a fixed skeleton with a box whose top face is z = 0, 1e4 R wide and 1 R thick (a
-  // sphere meets only the top face while its centre is above it); see collision_detector.
+  // The floor: a fixed skeleton with a box whose top face is z = 0, floor_width R wide and 1 R
+  // thick (a sphere meets only the top face while its centre is above it); see collision_detector.
   floor_skel_ = dynamics::Skeleton::create("floor");
   {
     auto pair = floor_skel_->createJointAndBodyNodePair<dynamics::WeldJoint>();
     dynamics::ShapePtr shape;
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    const double side = 1e4 * m.R, thick = m.R;
+    const double side = settings_.floor_width * m.R, thick = m.R;
     shape = std::make_shared<dynamics::BoxShape>(Eigen::Vector3d(side, side, thick));
     T.translation() = Eigen::Vector3d(0, 0, -0.5 * thick);
     auto* sn = pair.second->createShapeNodeWith<dynamics::CollisionAspect, dynamics::DynamicsAspect>(shape);
@@ -200,6 +212,8 @@ void DartSimulator::make_notes() {
   const ContactSpec& c = scene().contact;
   if (c.friction == FrictionLaw::Coulomb || c.friction == FrictionLaw::Rolling)
     notes_.push_back("Coulomb friction as a box in two tangent directions (pyramid, not cone), each bounded by mu F_n");
+  if (settings_.collision_detector == "bullet")
+    notes_.push_back("collision_detector = bullet: DART's Bullet backend, in single precision (Debian's Bullet build)");
   if (settings_.collision_detector == "fcl_mesh")
     notes_.push_back("collision_detector = fcl_mesh: FCL meshes stand in for the ball and the stem tip (faceted; contacts "
                      "can be missed or misplaced)");

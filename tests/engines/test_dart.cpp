@@ -1,0 +1,167 @@
+// DART's collision detectors: where each puts the contact of a ball pressed into the floor, and its Bullet backend in one process with the Bullet adapter.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <string>
+#include <utility>
+
+#include "engines/core/registry.h"
+#include "tests/support/fixtures.h"
+
+namespace tippe {
+namespace {
+
+Scene with_detector(Scene s, const std::string& detector) {
+  s.engines["dart"]["collision_detector"] = detector;
+  return s;
+}
+
+// Built into the DART module only where engines are modules (CMakeLists.txt).
+bool bullet_backend_built() { return engines_in_modules(); }
+
+struct PressedBall {
+  double horizontal = 0.0, vertical = 0.0;  // worst |engine's point - lowest point| / R
+  int missed = 0;                           // queries that reported no contact
+};
+
+// The ball (R = 1) pressed 1e-4..5e-4 R into the floor at `count` places and attitudes (tilt up to
+// 0.5 rad, so the ball and not the stem is lowest), its centre up to `reach` R from the origin,
+// each for one step from rest: the contact the step's collision pass found (at its start: DART
+// detects after the velocity update, before positions move) against the ball's lowest point.
+PressedBall press(const std::string& detector, double reach, int count, double floor_width = 1e4) {
+  Scene s = with_detector(fixtures::dimensionless_scene(), detector);
+  s.engines["dart"]["floor_width"] = floor_width;
+  s.initial.spin = 0.0;
+  auto sim = make_simulator("dart", s);
+  std::mt19937 rng(20261204);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  PressedBall out;
+  for (int i = 0; i < count; ++i) {
+    BodyState x = sim->state();
+    const double tilt = 0.5 * unit(rng), heading = 2 * M_PI * unit(rng), depth = 1e-4 + 4e-4 * unit(rng);
+    x.q_WB = Quat(Eigen::AngleAxisd(heading, Vec3::UnitZ()) * Eigen::AngleAxisd(tilt, Vec3::UnitX()));
+    x.v_WG.setZero();
+    x.w_B.setZero();
+    const double r = reach * unit(rng), at = 2 * M_PI * unit(rng);
+    // O = G + d e_Z (d = com_offset): the ball's centre placed, G follows.
+    const Vec3 p_GO_W = x.q_WB * Vec3(0, 0, s.mass.com_offset);
+    const Vec3 p_WO(r * std::cos(at), r * std::sin(at), s.body.sphere_radius - depth);
+    x.p_WG = p_WO - p_GO_W;
+    sim->set_state(x);
+    const Vec3 lowest = sim->observe().p_WC;
+    sim->advance_to(sim->state().t + 1e-4);  // one step at DART's default
+    const Observation o = sim->observe();
+    if (!o.engine_contact_valid) {
+      ++out.missed;
+      continue;
+    }
+    const Vec3 d = o.p_WC_engine - lowest;
+    out.horizontal = std::max(out.horizontal, std::hypot(d.x(), d.y()) / s.body.sphere_radius);
+    out.vertical = std::max(out.vertical, std::abs(d.z()) / s.body.sphere_radius);
+  }
+  return out;
+}
+
+// Per detector, the worst horizontal distance (in R) between the contact a step's collision pass
+// reports and the ball's lowest point, with its centre within 1 R and within 1000 R of the origin
+// (the floor is a box 1e4 R wide). Measured (50 places each, DART 6.12.1, FCL 0.7, Bullet 3.24):
+// "dart" 1.1e-16 and 1.1e-13 R, "fcl" 1.1e-16 and 1.2e-13 R (round-off at the place's size),
+// "bullet" 1.6e-3 and 1.2e-3 R (its single-precision test at the box's size: see
+// ContactErrorScalesWithTheFloorsWidth). Bounds: ten times the measured value, floored at 1e-12 R.
+struct DetectorBounds {
+  const char* detector;
+  double near, far;
+};
+const DetectorBounds kBounds[] = {
+    {"dart", 1e-12, 1.1e-12},
+    {"fcl", 1e-12, 1.2e-12},
+    {"bullet", 1.6e-2, 1.2e-2},
+};
+
+class DartDetector : public ::testing::TestWithParam<DetectorBounds> {};
+
+// The vertical part is where a detector puts the point inside the overlap, at most the depth
+// (below 5e-4 R): measured, "dart" and "bullet" on the floor's face (the depth), "fcl" halfway.
+TEST_P(DartDetector, FindsTheContactAtTheBallsLowestPoint) {
+  const DetectorBounds& row = GetParam();
+  if (std::string(row.detector) == "bullet" && !bullet_backend_built())
+    GTEST_SKIP() << "engines linked in: no Bullet backend for DART";
+  for (const auto& [reach, bound] : {std::pair{1.0, row.near}, std::pair{1000.0, row.far}}) {
+    const PressedBall b = press(row.detector, reach, 50);
+    std::printf("[%s] centre within %g R: horizontal %.2g R, vertical %.2g R, missed %d\n", row.detector, reach,
+                b.horizontal, b.vertical, b.missed);
+    EXPECT_EQ(b.missed, 0) << row.detector << " within " << reach << " R";
+    EXPECT_LE(b.vertical, 5e-4) << row.detector << " within " << reach << " R";
+    EXPECT_LE(b.horizontal, bound) << row.detector << " within " << reach << " R";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Detectors, DartDetector, ::testing::ValuesIn(kBounds),
+                         [](const auto& info) { return std::string(info.param.detector); });
+
+// The Bullet backend's contact error comes from single-precision arithmetic at the floor box's
+// size (dart_settings.h, floor_width): a box 100 R wide instead of 1e4 R puts the contact within
+// about 1e-5 R of the lowest point. Measured (50 places within 1 R): 1.6e-3 R at 1e4 R, 9.3e-6 R
+// at 100 R. Bounds: ten times the narrow floor's, and a tenth of the wide floor's as its floor (the
+// effect is there).
+TEST(DartBulletBackend, ContactErrorScalesWithTheFloorsWidth) {
+  if (!bullet_backend_built()) GTEST_SKIP() << "engines linked in: no Bullet backend for DART";
+  const PressedBall wide = press("bullet", 1.0, 50, 1e4), narrow = press("bullet", 1.0, 50, 100.0);
+  std::printf("[bullet] floor 1e4 R: %.2g R, 100 R: %.2g R\n", wide.horizontal, narrow.horizontal);
+  EXPECT_EQ(narrow.missed, 0);
+  EXPECT_LE(narrow.horizontal, 9.3e-5);
+  EXPECT_GE(wide.horizontal, 1.6e-4);
+}
+
+// The final state of `engine` on the viscous dimensionless top after 0.3 time units.
+BodyState run_for(const std::string& engine, const Scene& s) {
+  auto sim = make_simulator(engine, s);
+  sim->advance_to(0.3);
+  EXPECT_EQ(sim->status(), RunStatus::Ok) << engine << ": " << sim->status_detail();
+  return sim->state();
+}
+
+bool same_bits(const BodyState& a, const BodyState& b) {
+  auto eq = [](const auto& u, const auto& v) { return std::memcmp(u.data(), v.data(), sizeof(double) * u.size()) == 0; };
+  return eq(a.p_WG, b.p_WG) && eq(a.v_WG, b.v_WG) && eq(a.q_WB.coeffs(), b.q_WB.coeffs()) && eq(a.w_B, b.w_B);
+}
+
+bool maps_library(const std::string& file) {
+  std::ifstream maps("/proc/self/maps");
+  for (std::string line; std::getline(maps, line);)
+    if (line.size() >= file.size() && line.compare(line.size() - file.size(), file.size(), file) == 0) return true;
+  return false;
+}
+
+// DART's Bullet backend links Debian's single-precision Bullet, the Bullet adapter the
+// double-precision build; both export the same C++ symbols. Each adapter is a module opened with
+// RTLD_LOCAL, so each must bind its own: the Bullet adapter's run is bit-identical before and after
+// DART's Bullet is loaded, DART's with the Bullet backend repeats bit for bit, and it stays near
+// DART's own exact detector (a backend bound to the other precision's code would read its
+// structures with the wrong layout). Measured against DART's detector after 0.3 time units:
+// |dp_G| 1.2e-4 R, |dw| 9.4e-4 (of |w| about 5); with a 100 R floor 1.1e-4 R and 9.7e-4, so the
+// contact point's error is not what moves it. Bounds: ten times those.
+TEST(DartBulletBackend, RunsBesideTheBulletAdapterInOneProcess) {
+  if (!bullet_backend_built()) GTEST_SKIP() << "engines linked in: no Bullet backend for DART";
+  Scene s = fixtures::dimensionless_scene(FrictionLaw::Viscous, 1.0);
+  const BodyState bullet_before = run_for("bullet", s);
+  ASSERT_TRUE(maps_library("libBulletCollision-float64.so.3.24"));
+  const BodyState dart_bullet = run_for("dart", with_detector(s, "bullet"));
+  EXPECT_TRUE(maps_library("libBulletCollision.so.3.24")) << "DART's backend maps the single-precision Bullet";
+  EXPECT_TRUE(maps_library("libBulletCollision-float64.so.3.24"));
+  EXPECT_TRUE(same_bits(run_for("bullet", s), bullet_before)) << "the Bullet adapter's run moved";
+  EXPECT_TRUE(same_bits(run_for("dart", with_detector(s, "bullet")), dart_bullet)) << "DART's Bullet backend does not repeat";
+  const BodyState dart_own = run_for("dart", s);
+  const double dp = (dart_bullet.p_WG - dart_own.p_WG).norm(), dw = (dart_bullet.w_B - dart_own.w_B).norm();
+  std::printf("dart: bullet backend against its own detector after 0.3: |dp_G| %.2g R, |dw| %.2g\n", dp, dw);
+  EXPECT_LE(dp, 1.2e-3);
+  EXPECT_LE(dw, 9.4e-3);
+}
+
+}  // namespace
+}  // namespace tippe
