@@ -35,11 +35,10 @@ struct DartSettings {
   // default of DART's FCL detector does to a ball. A plane is not used: DART 6.12's FCL detector
   // turns a PlaneShape into a thin box mesh, and its own detector has no plane (the Bullet
   // backend has one, btStaticPlaneShape: its runs were not examined, so every detector keeps the
-  // same box). Neither detector
-  // has a capsule (FCL replaces a CapsuleShape by a sphere of radius 0.1 with an error message),
-  // so the stem is the sphere of radius r at its tip P: on a plane that is the same contact as the
-  // capsule O-P the other engines use (the capsule's O end lies inside the ball, r < R, so only
-  // its P end can reach the floor).
+  // same box). Neither DART nor FCL has a capsule (FCL replaces a CapsuleShape by a sphere of
+  // radius 0.1 with an error message), so the stem is the sphere of radius r at its tip P: on a
+  // plane that is the same contact as the capsule O-P the other engines use (the capsule's O end
+  // lies inside the ball, r < R, so only its P end can reach the floor).
   std::string collision_detector = "dart";
   // The floor box's width in ball radii (it is 1 R thick). Only the Bullet backend's answer
   // depends on it: its convex-convex test (GJK on the box's corners, in single precision) works

@@ -1,17 +1,19 @@
-// DART's collision detectors: where each puts the contact of a ball pressed into the floor, and its Bullet backend in one process with the Bullet adapter.
+// DART's collision detectors: where each puts the contact of a ball pressed into the floor, what the Bullet backend's error does to toy's verdict, and that backend in one process with the Bullet adapter.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <random>
 #include <string>
 #include <utility>
 
 #include "engines/core/registry.h"
+#include "harness/io/scene_io.h"
+#include "harness/scene/resolve.h"
 #include "tests/support/fixtures.h"
+#include "tests/support/mapped_files.h"
 
 namespace tippe {
 namespace {
@@ -118,6 +120,27 @@ TEST(DartBulletBackend, ContactErrorScalesWithTheFloorsWidth) {
   EXPECT_GE(wide.horizontal, 1.6e-4);
 }
 
+// What the contact's error does to a verdict (modelling.toml, setup dart-bullet-floor): on toy
+// (Coulomb, the reference rolls to 8 s) at timestep 1.25e-4, DART on its Bullet backend inverts at
+// 6.56 s on the default floor (1e4 R) and rolls to 8 s, as the reference does, on a 100 R floor
+// (docs/findings/dart-bullet-backend.md). The two runs differ in the floor's width alone.
+TEST(DartBulletBackend, FloorWidthMovesToysRegime) {
+  if (!bullet_backend_built()) GTEST_SKIP() << "engines linked in: no Bullet backend for DART";
+  auto inversions = [](const std::string& width) {
+    const Scene s = load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/toy.toml",
+                               {"run.duration=8", "engines.dart.collision_detector=\"bullet\"",
+                                "engines.dart.timestep=1.25e-4", "engines.dart.floor_width=" + width});
+    auto sim = make_simulator("dart", s);
+    sim->advance_to(s.run.duration);
+    EXPECT_EQ(sim->status(), RunStatus::Ok) << sim->status_detail();
+    int n = 0;
+    for (const Event& e : sim->events()) n += e.name == "inversion";
+    return n;
+  };
+  EXPECT_GE(inversions("1e4"), 1) << "on the default floor the Bullet backend inverts toy";
+  EXPECT_EQ(inversions("100"), 0) << "on a 100 R floor it rolls, as the reference does";
+}
+
 // The final state of `engine` on the viscous dimensionless top after 0.3 time units.
 BodyState run_for(const std::string& engine, const Scene& s) {
   auto sim = make_simulator(engine, s);
@@ -131,12 +154,7 @@ bool same_bits(const BodyState& a, const BodyState& b) {
   return eq(a.p_WG, b.p_WG) && eq(a.v_WG, b.v_WG) && eq(a.q_WB.coeffs(), b.q_WB.coeffs()) && eq(a.w_B, b.w_B);
 }
 
-bool maps_library(const std::string& file) {
-  std::ifstream maps("/proc/self/maps");
-  for (std::string line; std::getline(maps, line);)
-    if (line.size() >= file.size() && line.compare(line.size() - file.size(), file.size(), file) == 0) return true;
-  return false;
-}
+bool maps_library(const std::string& file) { return !mapped_lines({file}).empty(); }
 
 // DART's Bullet backend links Debian's single-precision Bullet, the Bullet adapter the
 // double-precision build; both export the same C++ symbols. Each adapter is a module opened with

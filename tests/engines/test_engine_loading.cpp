@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -12,6 +13,7 @@
 #include "engines/mujoco/mujoco_api.h"
 #include "engines/core/registry.h"
 #include "engines/core/step_checks.h"
+#include "tests/support/mapped_files.h"
 #include "tests/support/process.h"
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
@@ -138,12 +140,7 @@ TEST(EngineLoading, UnloadableModuleNamesThePathAndTheLoadersReason) {
 
 // The lines of this process's /proc/self/maps that name an engine's library.
 std::string mapped_engine_libraries() {
-  std::ifstream maps("/proc/self/maps");
-  std::string line, found;
-  while (std::getline(maps, line))
-    for (const char* lib : kEngineLibraries)
-      if (line.find(lib) != std::string::npos) found += line + "\n";
-  return found;
+  return mapped_lines(std::vector<std::string>(std::begin(kEngineLibraries), std::end(kEngineLibraries)));
 }
 
 tippe::Scene toy() {
