@@ -30,6 +30,9 @@ const std::vector<std::string>& run_status_names();
 const std::vector<std::string>& event_names();
 
 
+// The doc of every record's git_commit field (the run's provenance and the sweep point's).
+inline constexpr char kGitCommitDoc[] = "the commit the build was made from; \"-dirty\" appended when its tracked files had changes";
+
 struct Provenance {
   std::string git_commit, compiler, cxx_flags;  // from build_info()
   std::string date;                             // UTC, ISO 8601, when the run started
@@ -37,7 +40,7 @@ struct Provenance {
 };
 template <class R, class V>
 std::enable_if_t<std::is_same_v<std::remove_const_t<R>, Provenance>> visit(R& p, V& v) {
-  v(Field("git_commit", "the commit the build was made from; \"-dirty\" appended when its tracked files had changes"), p.git_commit);
+  v(Field("git_commit", kGitCommitDoc), p.git_commit);
   v(Field("compiler"), p.compiler);
   v(Field("cxx_flags"), p.cxx_flags);
   v(Field("date", "UTC, ISO 8601, when the run started"), p.date);

@@ -256,7 +256,7 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, SweepRecord>> visit(R& r
     g(SweepField("solver_iterations").range(0, kMaxSweepCount), r.solver_iterations);
   });
   v(SweepField("engine_version"), r.engine_version);
-  v(SweepField("git_commit", "the commit the build was made from; \"-dirty\" appended when its tracked files had changes"), r.git_commit);
+  v(SweepField("git_commit", kGitCommitDoc), r.git_commit);
   v(SweepField("settings", "every accuracy setting in force, each as text"), r.settings);
   // Absent in records written before classification: the class the status implies.
   v.group(SweepField("class", "the stability class of the run (README, 'Stability map'); absent in records written "
