@@ -8,12 +8,14 @@
 #include "harness/cli/cli.h"
 #include "harness/io/progress.h"
 #include "harness/io/provenance.h"
+#include "engines/core/process.h"
 #include "engines/core/registry.h"
 #include "include/tippe/tippe.h"
 #include "harness/io/scene_io.h"
 
 int main(int argc, char** argv) {
   using namespace tippe;
+  prepare_process_for_engines();  // first: before any thread or engine module
   CLI::App app{"tippe: the tippe-top verification bench"};
   app.require_subcommand(1);
   // Every subcommand takes --quiet, also after its own options: subcommands made after

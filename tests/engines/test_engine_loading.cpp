@@ -1,12 +1,15 @@
-// Which engine libraries a `tippe` process maps (a reference run and `tippe --version` need none), and the engine modules across their boundary.
+// Which engine libraries a `tippe` process maps (a reference run and `tippe --version` need none), the engine modules across their boundary, and the BLAS threads a Siconos run starts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "engines/core/fixed_step.h"
@@ -198,4 +201,75 @@ TEST(EngineModules, NamesWithoutLoading) {
   EXPECT_EQ(tippe::engine_module_file("bullet"), "libtippe_engine_bullet.so");
   EXPECT_FALSE(tippe::engine_loaded("no_such_engine"));
   EXPECT_EQ(tippe::find_engine("no_such_engine"), nullptr);
+}
+
+namespace {
+
+// What a `tippe run` of Siconos showed of its threads: the most /proc/PID/status listed while it
+// ran (polled every 0.5 ms), and whether OpenBLAS was among its mapped files.
+struct ThreadsSeen {
+  int most = 0;
+  bool openblas = false;
+  int exit_code = -1;
+};
+
+ThreadsSeen siconos_run_threads(const std::string& blas_threads) {
+  const fs::path dir = scratch();
+  // "" runs tippe without the variable; otherwise with the value given.
+  std::vector<std::string> argv = {"env", "-u", "OPENBLAS_NUM_THREADS"};
+  if (!blas_threads.empty()) argv.push_back("OPENBLAS_NUM_THREADS=" + blas_threads);
+  argv.push_back(std::string(TIPPE_BINARY_DIR) + "/tippe");
+  // Long enough (0.1-0.2 s, more under the sanitizers) for thousands of polls after the module loads.
+  for (const std::string& a : {std::string("run"), std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/toy_viscous.toml",
+                               std::string("--engine"), std::string("siconos"), std::string("--set"),
+                               std::string("run.duration=0.5"), std::string("--out"),
+                               (dir / ("run-" + blas_threads)).string(), std::string("--quiet")})
+    argv.push_back(a);
+  const pid_t pid = spawn_process(argv, dir / "out.txt", dir / "err.txt");
+  ThreadsSeen seen;
+  const std::string status_file = "/proc/" + std::to_string(pid) + "/status";
+  const std::string maps_file = "/proc/" + std::to_string(pid) + "/maps";
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(300);
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) != pid) {
+    if (std::chrono::steady_clock::now() > end) {
+      ::kill(pid, SIGKILL);
+      wait_process(pid);
+      ADD_FAILURE() << "tippe run --engine siconos still running after 300 s";
+      return seen;
+    }
+    std::ifstream in(status_file);
+    std::string line;
+    while (std::getline(in, line))
+      if (line.rfind("Threads:", 0) == 0) seen.most = std::max(seen.most, std::stoi(line.substr(8)));
+    if (!seen.openblas) {
+      std::ifstream maps(maps_file);
+      std::stringstream text;
+      text << maps.rdbuf();
+      seen.openblas = text.str().find("openblas") != std::string::npos;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  seen.exit_code = exit_of(status).code;
+  return seen;
+}
+
+}  // namespace
+
+// A Siconos run in a `tippe` process starts no BLAS thread team (engines/core/process.h): run
+// without OPENBLAS_NUM_THREADS, its most threads are those of a run with the variable at 1; the
+// control, the variable at 2, shows that the probe sees a team when OpenBLAS starts one.
+TEST(EngineProcess, SiconosRunStartsNoBlasThreadTeam) {
+  const std::vector<std::string> names = tippe::available_engines();
+  if (std::find(names.begin(), names.end(), "siconos") == names.end()) GTEST_SKIP() << "no Siconos in this build";
+  // OpenBLAS starts no team on one CPU, whatever the variable says.
+  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one CPU: OpenBLAS starts no thread team";
+  const ThreadsSeen one = siconos_run_threads("1"), unset = siconos_run_threads(""), two = siconos_run_threads("2");
+  ASSERT_EQ(one.exit_code, 0);
+  ASSERT_EQ(unset.exit_code, 0);
+  ASSERT_EQ(two.exit_code, 0);
+  if (!one.openblas) GTEST_SKIP() << "Siconos' BLAS here is not OpenBLAS (the libblas.so.3 alternative)";
+  EXPECT_GT(two.most, one.most) << "the control: with OPENBLAS_NUM_THREADS=2 the probe saw no more threads";
+  EXPECT_EQ(unset.most, one.most) << "without OPENBLAS_NUM_THREADS, a Siconos run had " << unset.most
+                                  << " threads at most, against " << one.most << " with it at 1";
 }
