@@ -70,8 +70,41 @@ std::string compute_self_check_text(const Scene& scene, const Reference& ref);
 void store_self_check_text(const std::filesystem::path& dir, const Scene& scene, const std::string& hash,
                            const std::string& text, Reference& ref);
 
-// Runs one point `repeats` times on the calling thread into its record.
-SweepRecord run_point(const SweepPlan& plan, const SweepPoint& p, const Reference& ref);
+// A point's repeats are interleaved with other points' runs, so that a slow phase of the machine
+// (a heavy neighbour on the other core, the host's load) is unlikely to last through all of
+// them: the point's record comes from its first run, and each later repeat adds its times.
+struct RepeatTime {
+  double cpu = 0, wall = 0;  // the run's own thread's CPU seconds, wall seconds
+};
+struct FirstRun {
+  SweepRecord record;
+  double final_time = std::nan("");     // the simulated time the run reached (real_time_factor)
+  double reference_cpu = 0;             // the reference's CPU seconds (cost_ratio)
+  bool timed = true;                    // false: the scene's reference failed and nothing ran
+};
+// Runs the point once on the calling thread into its record, its times those of this run.
+FirstRun run_point_first(const SweepPlan& plan, const SweepPoint& p, const Reference& ref);
+// Runs the point again for its times alone; none when it throws (its first run's record says why)
+// or when its scene's reference failed.
+std::optional<RepeatTime> time_point(const SweepPlan& plan, const SweepPoint& p, const Reference& ref);
+// Every repeat's times, in the order they ran (the first run's first), into the record: CPU and
+// wall seconds their minima, cpu_seconds_repeats the list, cost_ratio and real_time_factor from them.
+void set_repeat_times(FirstRun& f, const std::vector<RepeatTime>& times);
+// The tasks' texts, as a worker (another rank) sends them back: exact both ways.
+std::string first_run_text(const FirstRun& f);
+FirstRun read_first_run_text(const std::string& text);
+std::string repeat_time_text(const std::optional<RepeatTime>& t);
+std::optional<RepeatTime> read_repeat_time_text(const std::string& text);
+// The order the runs are handed out in: for each block of `block` consecutive points (indices
+// 0..points-1 of the order they are to run in), `repeats` rounds over the block, each running every
+// point of it once. Between two repeats of a point every other point of its block runs once; a
+// point's record is complete when its block's last round reaches it, so an interrupted sweep loses
+// at most a block's runs. repeats = 1: each point once, in order.
+struct SweepTask {
+  size_t point = 0;  // index into the points to run
+  int round = 0;     // 0: the run that makes the record; 1..repeats-1: timing only
+};
+std::vector<SweepTask> repeat_schedule(size_t points, int repeats, size_t block);
 // A priori cost of a point in arbitrary units (steps for a time-step ladder).
 double point_weight(const SweepPlan& plan, const SweepPoint& p);
 

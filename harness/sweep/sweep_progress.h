@@ -26,34 +26,44 @@ inline std::string clock_text(double seconds) {
   return buf;
 }
 
-// The one progress line: points done, what runs, elapsed and an estimate of the time left. Each
-// setup's wall time is fitted as a + b * weight over its finished points: a is the per-point
-// overhead (a MuJoCo model compile, the comparison), which would make a plain ratio taken on a
-// short point overestimate every long one.
+// The one progress line: points done, what runs, elapsed and an estimate of the time left. Its
+// unit of work is one run of a point (a point runs `repeats` times, interleaved: repeat_schedule).
+// Each setup's wall time of a run is fitted as a + b * weight over its finished runs: a is the
+// per-run overhead (a MuJoCo model compile, the comparison), which would make a plain ratio taken
+// on a short point overestimate every long one.
 class SweepProgress {
  public:
-  // total: the points of this run's share (the whole plan, or a shard's); lines: one full line
-  // every 10 s instead of redrawing one (stderr passed on by an MPI launcher).
-  SweepProgress(const SweepPlan& plan, std::vector<size_t> todo, size_t total, size_t skipped, int jobs, bool lines)
+  // todo: the points to run (indices into plan.points), tasks: their runs in the order handed out
+  // (indices into todo); total: the points of this run's share (the whole plan, or a shard's);
+  // lines: one full line every 10 s instead of redrawing one (stderr passed on by an MPI launcher).
+  SweepProgress(const SweepPlan& plan, std::vector<size_t> todo, std::vector<SweepTask> tasks, int repeats,
+                size_t total, size_t skipped, int jobs, bool lines)
       : plan_(plan),
         todo_(std::move(todo)),
+        tasks_(std::move(tasks)),
+        repeats_(std::max(repeats, 1)),
         total_(total),
         skipped_(skipped),
         jobs_(jobs),
         lines_(lines),
         start_(now()),
-        started_(plan.points.size(), -1.0),
-        finished_(plan.points.size(), false) {}
+        started_(tasks_.size(), -1.0),
+        finished_(tasks_.size(), false) {}
 
-  void begin(size_t point) {
+  void begin(size_t task) {
     std::lock_guard<std::mutex> lock(m_);
-    started_[point] = now() - start_;
+    started_[task] = now() - start_;
   }
-  void end(size_t point, double wall) {
+  void end(size_t task, double wall) {
     std::lock_guard<std::mutex> lock(m_);
-    finished_[point] = true;
+    finished_[task] = true;
+    const SweepPoint& p = point(task);
+    samples_[p.setup_index].emplace_back(weight(p), wall);
+  }
+  // A point's last run came in and its record is written.
+  void point_done() {
+    std::lock_guard<std::mutex> lock(m_);
     ++done_;
-    samples_[plan_.points[point].setup_index].emplace_back(point_weight(plan_, plan_.points[point]), wall);
   }
 
   void print(bool final_line) {
@@ -65,9 +75,15 @@ class SweepProgress {
     std::snprintf(buf, sizeof buf, "[sweep] %zu/%zu points", done_ + skipped_, total_);
     std::string line = buf;
     if (skipped_) line += " (" + std::to_string(skipped_) + " from an earlier run)";
-    size_t running = 0;
-    for (size_t p : todo_) running += started_[p] >= 0 && !finished_[p];
+    size_t running = 0, next = tasks_.size();
+    for (size_t k = 0; k < tasks_.size(); ++k) {
+      running += started_[k] >= 0 && !finished_[k];
+      if (started_[k] < 0 && next == tasks_.size()) next = k;
+    }
     if (!final_line) line += " | " + std::to_string(running) + " running";
+    // Which repeat is being handed out (the block's round), when a point runs more than once.
+    if (!final_line && repeats_ > 1 && next < tasks_.size())
+      line += " | repeat " + std::to_string(tasks_[next].round + 1) + "/" + std::to_string(repeats_);
     line += " | " + clock_text(elapsed) + " elapsed";
     if (!final_line) {
       const double left = estimate_left(elapsed);
@@ -77,10 +93,13 @@ class SweepProgress {
   }
 
  private:
+  const SweepPoint& point(size_t task) const { return plan_.points[todo_[tasks_[task].point]]; }
+  // One run's share of the point's a priori weight (which counts every repeat).
+  double weight(const SweepPoint& p) const { return point_weight(plan_, p) / repeats_; }
   static double now() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   }
-  // Expected wall seconds of a point of weight w of this setup; NaN before any point finished.
+  // Expected wall seconds of a run of weight w of this setup; NaN before any run finished.
   double expect(size_t setup, double w) const {
     auto it = samples_.find(setup);
     double sw = 0, st = 0;
@@ -111,16 +130,19 @@ class SweepProgress {
   double estimate_left(double elapsed) const {
     if (samples_.empty()) return std::nan("");
     double left = 0;
-    for (size_t p : todo_) {
-      if (finished_[p]) continue;
-      const double expect = this->expect(plan_.points[p].setup_index, point_weight(plan_, plan_.points[p]));
-      left += started_[p] >= 0 ? std::max(0.0, expect - (elapsed - started_[p])) : expect;
+    for (size_t k = 0; k < tasks_.size(); ++k) {
+      if (finished_[k]) continue;
+      const SweepPoint& p = point(k);
+      const double expect = this->expect(p.setup_index, weight(p));
+      left += started_[k] >= 0 ? std::max(0.0, expect - (elapsed - started_[k])) : expect;
     }
     return left / jobs_;
   }
 
   const SweepPlan& plan_;
   std::vector<size_t> todo_;
+  std::vector<SweepTask> tasks_;
+  int repeats_;
   size_t total_, skipped_;
   int jobs_;
   bool lines_;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
@@ -455,33 +456,66 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
         std::fprintf(stderr, "tippe: warning: %s; its %zu point(s) are recorded as failed\n", refs[i].failure.c_str(), n);
       }
 
-  // 5. The points: each runs once, on some worker; the coordinator appends its line.
+  // 5. The points, each run `repeats` times (repeat_schedule: its repeats interleaved with other
+  // points' runs), each run on some worker; the coordinator folds a point's repeats into its record
+  // and appends its line when the last has come in.
   if (!prep.todo.empty()) {
+    const int repeats = plan.spec.repeats;
+    // 32 points: between two repeats of a point the 31 others of its block run once (some 15
+    // point-lengths on two workers), so neither a neighbour on the other core nor a slow spell of
+    // the host lasts through all of a point's repeats; an interrupted sweep loses at most 32
+    // points' runs. Four per worker on a larger farm, so that a block keeps every worker busy.
+    const size_t block = std::max<size_t>(32, 4 * static_cast<size_t>(std::max(farm.workers(), 1)));
+    const std::vector<SweepTask> tasks = repeat_schedule(prep.todo.size(), repeats, block);
     std::unique_ptr<RecordAppender> appender;
     std::unique_ptr<SweepProgress> progress;
-    std::vector<std::chrono::steady_clock::time_point> started(prep.todo.size());
+    std::vector<std::chrono::steady_clock::time_point> started(tasks.size());
+    // On the coordinator, per point (index into prep.todo): its first run, and every run's times by round.
+    std::vector<std::optional<FirstRun>> firsts(prep.todo.size());
+    std::vector<std::vector<std::optional<RepeatTime>>> times(prep.todo.size(),
+                                                              std::vector<std::optional<RepeatTime>>(repeats));
+    std::vector<int> arrived(prep.todo.size(), 0);
     if (farm.coordinator()) {
       appender = std::make_unique<RecordAppender>(records_file);
-      progress = std::make_unique<SweepProgress>(plan, prep.todo, prep.share, prep.skipped, farm.workers(),
-                                                 farm.distributed() || progress_mode() == ProgressMode::Lines);
+      progress = std::make_unique<SweepProgress>(plan, prep.todo, tasks, repeats, prep.share, prep.skipped,
+                                                 farm.workers(), farm.distributed() || progress_mode() == ProgressMode::Lines);
     }
     const bool show = o.progress && progress_mode() != ProgressMode::Quiet;
     TaskFarm::Idle idle;
     if (show && farm.coordinator()) idle = [&] { progress->print(false); };
     farm.run(
-        prep.todo.size(),
+        tasks.size(),
         [&](size_t k) {
-          const size_t p = prep.todo[k];
-          return to_jsonl(run_point(plan, plan.points[p], refs[plan.points[p].scene_index]));
+          const SweepPoint& p = plan.points[prep.todo[tasks[k].point]];
+          const Reference& ref = refs[p.scene_index];
+          return tasks[k].round == 0 ? first_run_text(run_point_first(plan, p, ref))
+                                     : repeat_time_text(time_point(plan, p, ref));
         },
-        [&](size_t k, std::string&& line) {
-          appender->append(line);
-          progress->end(prep.todo[k],
-                        std::chrono::duration<double>(std::chrono::steady_clock::now() - started[k]).count());
+        [&](size_t k, std::string&& text) {
+          const size_t j = tasks[k].point;
+          const int round = tasks[k].round;
+          if (round == 0) {
+            firsts[j] = read_first_run_text(text);
+            const FirstRun& f = *firsts[j];
+            if (f.timed && !f.record.cpu_seconds_repeats.empty())
+              times[j][0] = RepeatTime{f.record.cpu_seconds_repeats.front(), f.record.wall_seconds};
+          } else {
+            times[j][static_cast<size_t>(round)] = read_repeat_time_text(text);
+          }
+          progress->end(k, std::chrono::duration<double>(std::chrono::steady_clock::now() - started[k]).count());
+          if (++arrived[j] < repeats) return;
+          FirstRun& f = *firsts[j];
+          std::vector<RepeatTime> ran;
+          for (const auto& t : times[j])
+            if (t) ran.push_back(*t);
+          set_repeat_times(f, ran);
+          appender->append(to_jsonl(f.record));
+          progress->point_done();
+          firsts[j].reset();
         },
         [&](size_t k) {
           started[k] = std::chrono::steady_clock::now();
-          progress->begin(prep.todo[k]);
+          progress->begin(k);
         },
         idle);
     if (show && farm.coordinator()) progress->print(true);
