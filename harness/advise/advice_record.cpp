@@ -31,6 +31,7 @@ AdviceRecord advice_record(const AdviceResult& result) {
       if (e.beyond > 0) x.first_unsafe_step = e.beyond;
       x.cpu_seconds = e.cpu_seconds;
       x.confirm_point = e.confirm_point;
+      x.near_ties = advice_ties_text(e);
     } else {
       x.reason = e.reason;
     }

@@ -24,6 +24,7 @@ struct EngineAdvice {
   std::optional<double> largest_safe_step, first_unsafe_step;
   std::optional<double> cpu_seconds;      // of the confirming run
   std::string confirm_point;              // its point id in confirm/records.jsonl
+  std::vector<std::string> near_ties;     // configurations not told apart from it by CPU time
   std::string reason;                     // why there is no advice
   long long configurations_searched = 0, configurations_not_searched = 0;
   std::vector<std::string> sensitivity;   // one sentence per axis
@@ -48,6 +49,10 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, EngineAdvice>> visit(R& 
   v(Field("cpu_seconds", "s: CPU of the confirming run").minimum(0), a.cpu_seconds);
   v(Field("confirm_point", "the confirming run's point id (confirm/records.jsonl); null: none").empty_as_null(),
     a.confirm_point);
+  v(Field("near_ties",
+          "the other configurations whose confirming run is safe at a CPU time within 10 % of the advised one's "
+          "(a difference the machine's noise could reverse), cheapest first: \"CONFIGURATION, KNOB STEP (CPU CPU s)\""),
+    a.near_ties);
   v(Field("reason", "why there is no advice; null: there is").empty_as_null(), a.reason);
   v(Field("configurations_searched", "configurations whose boundary was searched").minimum(0),
     a.configurations_searched);

@@ -188,6 +188,14 @@ std::vector<AdviceConfig> advice_configs(const std::string& engine, const std::v
   }
 }
 
+std::vector<std::string> advice_ties_text(const AdviceEngine& e) {
+  std::vector<std::string> out;
+  for (const AdviceEngine::Tie& x : e.ties)
+    out.push_back(e.configs.at(x.config).text() + ", " + e.knob + " " + search_value_text(x.step) + " (" +
+                  sig3(x.cpu_seconds) + " CPU s)");
+  return out;
+}
+
 void choose_advice(AdviceEngine& e, const SearchCriterion& criterion, const std::vector<SweepRecord>& confirm) {
   e.chosen.reset();
   double best = 0;
@@ -209,6 +217,18 @@ void choose_advice(AdviceEngine& e, const SearchCriterion& criterion, const std:
       e.confirm_point = r->point_id;
     }
   }
+  // The configurations the machine's noise could have chosen instead (sweep_analysis.h, kCostResolution).
+  e.ties.clear();
+  for (size_t i = 0; e.chosen && i < e.configs.size() && i < e.boundaries.size(); ++i) {
+    const SearchBoundary& b = e.boundaries[i];
+    if (i == *e.chosen || (b.status != "found" && b.status != "all_safe") || !b.boundary) continue;
+    const auto r = std::find_if(confirm.begin(), confirm.end(),
+                                [&](const SweepRecord& x) { return x.setup == e.configs[i].setup; });
+    if (r == confirm.end() || !is_safe(criterion, *r) || !std::isfinite(r->cpu_seconds)) continue;
+    if (r->cpu_seconds <= best * (1 + kCostResolution)) e.ties.push_back({i, r->ladder_value, r->cpu_seconds});
+  }
+  std::stable_sort(e.ties.begin(), e.ties.end(),
+                   [](const AdviceEngine::Tie& a, const AdviceEngine::Tie& b) { return a.cpu_seconds < b.cpu_seconds; });
   if (!e.chosen) {
     if (e.configs.empty()) e.reason = "no configuration searched (the run budget, --max-runs, allows none)";
     else if (safe_boundaries == 0) {
@@ -390,6 +410,9 @@ AdviceResult run_advise(const AdviseOptions& o) {
            " CPU s; the largest safe " + e.knob + " is " + search_value_text(e.boundary) +
            (e.beyond > 0 ? " (unsafe at " + search_value_text(e.beyond) + ")" : " (safe to the end of the range)");
       if (!e.sensitivity.empty()) t += "; " + join(e.sensitivity, ", ");
+      const std::vector<std::string> ties = advice_ties_text(e);
+      if (!ties.empty())
+        t += "; within " + sig3(100 * kCostResolution) + " % of its CPU time, not told apart: " + join(ties, "; ");
       t += ".";
     } else {
       t += "no advice: " + e.reason + ".";
@@ -413,10 +436,18 @@ AdviceResult run_advise(const AdviseOptions& o) {
     for (size_t i = 0; i < e.configs.size(); ++i) {
       const SearchBoundary& b = e.boundaries[i];
       const bool chosen = e.chosen && *e.chosen == i;
+      const auto tie = std::find_if(e.ties.begin(), e.ties.end(), [&](const AdviceEngine::Tie& x) { return x.config == i; });
+      std::string advised, cpu;
+      if (chosen) {
+        advised = search_value_text(e.step) + " (confirmed)";
+        cpu = sig3(e.cpu_seconds);
+      } else if (tie != e.ties.end()) {
+        advised = "not told apart: " + search_value_text(tie->step) + " (confirmed)";
+        cpu = sig3(tie->cpu_seconds);
+      }
       t.rows.push_back({e.engine, e.configs[i].text(), b.status.empty() ? "no records" : b.status,
                         b.boundary ? search_value_text(*b.boundary) : "-", b.beyond ? search_value_text(*b.beyond) : "-",
-                        std::to_string(b.runs), chosen ? search_value_text(e.step) + " (confirmed)" : "",
-                        chosen ? sig3(e.cpu_seconds) : ""});
+                        std::to_string(b.runs), advised, cpu});
     }
     for (const AdviceConfig& c : e.unsearched) t.rows.push_back({e.engine, c.text(), "not searched (budget)", "", "", "0", "", ""});
   }

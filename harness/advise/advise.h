@@ -53,6 +53,13 @@ struct AdviceEngine {
   double boundary = 0, beyond = 0;  // the chosen configuration's bracket (beyond 0: none in range)
   double cpu_seconds = 0;           // of the confirming run
   std::string confirm_point;        // its point id
+  // The other configurations whose confirming run is safe at a CPU time within kCostResolution
+  // (10 %) of the advised one's, cheapest first: (index into configs, its step, its CPU seconds).
+  struct Tie {
+    size_t config = 0;
+    double step = 0, cpu_seconds = 0;
+  };
+  std::vector<Tie> ties;
   std::string reason;               // why there is no advice
   std::vector<std::string> sensitivity;  // one sentence per axis
   std::vector<std::vector<std::string>> sensitivity_rows;  // axis, value, best boundary, factor
@@ -76,9 +83,12 @@ std::vector<AdviceConfig> advice_configs(const std::string& engine, const std::v
 // The choice from finished searches and confirming runs, a pure function of records (tested):
 // per engine, among the configurations whose search found a boundary or is all safe, those whose
 // confirming run (`confirm`, matched by setup name) is safe under `criterion`; the one whose
-// confirming run costs the least CPU. The sensitivity: per axis, the largest boundary over the
+// confirming run costs the least CPU, and those within kCostResolution of it (ties). The sensitivity: per axis, the largest boundary over the
 // configurations with each value, and the factor between the largest and smallest of those.
 void choose_advice(AdviceEngine& e, const SearchCriterion& criterion, const std::vector<SweepRecord>& confirm);
+
+// The ties as the page and the record say them: "CONFIGURATION, KNOB STEP (CPU CPU s)", cheapest first.
+std::vector<std::string> advice_ties_text(const AdviceEngine& e);
 
 // Runs everything: writes OUT/advise-sweep.toml and runs it into OUT/sweep (resumable), the
 // confirming runs (OUT/confirm-sweep.toml into OUT/confirm), then OUT/advice.toml (when some

@@ -6,6 +6,7 @@
 
 #include "harness/report/report.h"
 #include "harness/report/report_text.h"
+#include "harness/report/sweep_analysis.h"
 #include "harness/report/sweep_groups.h"
 
 namespace tippe {
@@ -53,6 +54,10 @@ DocTable sweep_matrix(const IndexSweep& sw, const std::string& page) {
         if (u.tier != "regime" && r.metrics.inversion_time_rel_error)
           text += " (" + pct(std::abs(*r.metrics.inversion_time_rel_error)) + ")";
         text += ", " + g3(r.cpu_seconds) + " CPU s";
+        // A near tie is part of the answer: the cell names how many, the page names them.
+        if (!u.ties.empty())
+          text += "; " + std::to_string(u.ties.size()) + " other" + (u.ties.size() > 1 ? "s" : "") + " within " +
+                  pct(kCostResolution);
         row.push_back(DocCell(text, "v-" + u.tier, sw.dir + "/" + page));
       }
     }

@@ -26,6 +26,16 @@ ConvergenceFit convergence_order(const std::vector<double>& h, const std::vector
 // The cheapest point (least cpu_seconds; ties: fewer steps) among `records` that is_safe under
 // `c` (the one criterion of "safe", sweep_record.h); -1 when none.
 long long cheapest_safe(const std::vector<SweepRecord>& records, const SearchCriterion& c);
+// Costs this bench does not tell apart: two CPU times (each a point's minimum over its repeats)
+// within 10 % of each other. Measured: one run repeated alone 265 times took 0.232-0.387 CPU s
+// (slow spells of 1.5x, seconds long); the minimum of three runs spread 30 s apart, as a sweep's
+// interleaved repeats are, ranged 0.232-0.250 (7.8 %), that of three back to back 0.232-0.333
+// (BENCHMARKS.md, "A point's repeats").
+inline constexpr double kCostResolution = 0.10;
+// The other points of `records` safe under `c` whose CPU time is within kCostResolution of
+// records[best]'s (best: cheapest_safe's answer), cheapest first; empty when best < 0. The
+// cheapest is the answer; these are named beside it, as the machine's noise could have chosen them.
+std::vector<size_t> cost_ties(const std::vector<SweepRecord>& records, long long best, const SearchCriterion& c);
 // The criterion the sweep page's "setting to use" applies on a scene: where the reference inverts,
 // the inversion within `tolerance`; where it does not, the reference's regime.
 SearchCriterion setting_criterion(bool reference_inverts, double tolerance);

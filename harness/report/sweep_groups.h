@@ -90,8 +90,13 @@ struct SettingToUse {
   std::optional<SweepRecord> point;
   std::string tier = "none";
   std::string why;
+  // The engine's other points that qualify the same way at a CPU time within kCostResolution
+  // (10 %) of the point's, cheapest first: a cost difference the machine does not resolve.
+  std::vector<SweepRecord> ties;
 };
 SettingToUse setting_to_use(const SceneGroup& s, const std::string& engine);
+// " (within 10 % of its CPU time, not told apart: SETUP SETTING 0.29 s; ...)", or "" without ties.
+std::string ties_text(const std::vector<SweepRecord>& ties);
 // The engines of the records, in the order their setups first appear.
 std::vector<std::string> engines_of(const std::vector<SceneGroup>& scenes);
 

@@ -118,8 +118,10 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
              "inversion within the bound (the one criterion of the page's opening: finished, classed ok by the "
              "stability map, |relative inversion-time error| <= the bound). \"Analytic at least as "
              "accurate\": the cheapest point of the analytic model's own ladders with an error no larger than "
-             "this point's; the ratio is this point's CPU time over that one's.");
-    SweepTable t{{"engine", "error below", "setup", "setting", "inversion error", "CPU s", "steps",
+             "this point's; the ratio is this point's CPU time over that one's. \"Not told apart\": the "
+             "engine's other points safe within the same bound at a CPU time within " + pct(kCostResolution) +
+             " of this one's, a difference the machine's noise could reverse.");
+    SweepTable t{{"engine", "error below", "setup", "setting", "inversion error", "CPU s", "not told apart", "steps",
              "analytic at least as accurate", "cost ratio"},
             {}};
     for (const std::string& e : engines) {
@@ -129,7 +131,7 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
       for (double bound : {0.1, 0.01, 0.001}) {
         const long long i = cheapest_below(mine, bound);
         if (i < 0) {
-          t.rows.push_back({e, pct(bound), "none reaches it", "", "", "", "", "", ""});
+          t.rows.push_back({e, pct(bound), "none reaches it", "", "", "", "", "", "", ""});
           continue;
         }
         const SweepRecord& r = mine[static_cast<size_t>(i)];
@@ -142,8 +144,12 @@ void scene_section(const SceneGroup& s, size_t scene, const std::vector<std::str
                    pct(std::abs(*ar.metrics.inversion_time_rel_error)) + ")";
           if (ar.cpu_seconds > 0) ratio = g3(r.cpu_seconds / ar.cpu_seconds);
         }
+        std::vector<std::string> ties;
+        for (size_t k : cost_ties(mine, i, setting_criterion(true, bound)))
+          ties.push_back(mine[k].setup + " " + short_setting(mine[k]) + ": " + g3(mine[k].cpu_seconds) + " s");
         t.rows.push_back({e, pct(bound), r.setup, setting_text(r), pct(*r.metrics.inversion_time_rel_error),
-                          g3(r.cpu_seconds), std::to_string(r.steps), a_text, ratio});
+                          g3(r.cpu_seconds), ties.empty() ? "-" : join_list(ties, "; "), std::to_string(r.steps),
+                          a_text, ratio});
       }
     }
     doc.table(to_doc(t));

@@ -31,14 +31,19 @@ SettingToUse setting_to_use(const SceneGroup& s, const std::string& e) {
     if (u.engine == e) mine.insert(mine.end(), u.points.begin(), u.points.end());
   out.found = !mine.empty();
   if (!out.found) return out;
+  // The answer under criterion c, and the points the machine's noise could have chosen instead.
+  const auto choose = [&](const SearchCriterion& c) {
+    const long long i = cheapest_safe(mine, c);
+    if (i < 0) return false;
+    out.point = mine[static_cast<size_t>(i)];
+    for (size_t k : cost_ties(mine, i, c)) out.ties.push_back(mine[k]);
+    return true;
+  };
   if (s.reference_inversion) {
-    long long i = cheapest_safe(mine, setting_criterion(true, 0.01));
-    if (i >= 0) {
-      out.point = mine[static_cast<size_t>(i)];
+    if (choose(setting_criterion(true, 0.01))) {
       out.tier = "1pct";
       out.why = "the cheapest safe within 1 %: " + pct(std::abs(*out.point->metrics.inversion_time_rel_error));
-    } else if ((i = cheapest_safe(mine, setting_criterion(true, 0.1))) >= 0) {
-      out.point = mine[static_cast<size_t>(i)];
+    } else if (choose(setting_criterion(true, 0.1))) {
       out.tier = "10pct";
       out.why = "none safe within 1 %; the cheapest safe within 10 %: " +
                 pct(std::abs(*out.point->metrics.inversion_time_rel_error));
@@ -46,9 +51,7 @@ SettingToUse setting_to_use(const SceneGroup& s, const std::string& e) {
       out.why = "no safe point within 10 % of the reference's inversion time";
     }
   } else {
-    const long long i = cheapest_safe(mine, setting_criterion(false, 0));
-    if (i >= 0) {
-      out.point = mine[static_cast<size_t>(i)];
+    if (choose(setting_criterion(false, 0))) {
       out.tier = "regime";
       out.why = "the cheapest safe: in the reference's regime";
     } else {
@@ -56,6 +59,13 @@ SettingToUse setting_to_use(const SceneGroup& s, const std::string& e) {
     }
   }
   return out;
+}
+
+std::string ties_text(const std::vector<SweepRecord>& ties) {
+  if (ties.empty()) return "";
+  std::vector<std::string> names;
+  for (const SweepRecord& r : ties) names.push_back(r.setup + " " + short_setting(r) + " " + g3(r.cpu_seconds) + " s");
+  return " (within " + pct(kCostResolution) + " of its CPU time, not told apart: " + join_list(names, "; ") + ")";
 }
 
 // sweep_groups.h says what each sentence holds.
@@ -88,7 +98,7 @@ std::vector<std::string> sweep_verdicts(const std::vector<SceneGroup>& scenes) {
       const SettingToUse u = setting_to_use(s, e);
       if (u.point)
         use.push_back("on " + s.name + " " + u.point->setup + " " + short_setting(*u.point) + " (" + u.why + ", " +
-                      g3(u.point->cpu_seconds) + " CPU s)");
+                      g3(u.point->cpu_seconds) + " CPU s)" + ties_text(u.ties));
       else
         use.push_back("on " + s.name + " none (" + u.why + ")");
     }

@@ -461,11 +461,14 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& o, TaskFarm& f
   // and appends its line when the last has come in.
   if (!prep.todo.empty()) {
     const int repeats = plan.spec.repeats;
-    // 32 points: between two repeats of a point the 31 others of its block run once (some 15
-    // point-lengths on two workers), so neither a neighbour on the other core nor a slow spell of
-    // the host lasts through all of a point's repeats; an interrupted sweep loses at most 32
-    // points' runs. Four per worker on a larger farm, so that a block keeps every worker busy.
-    const size_t block = std::max<size_t>(32, 4 * static_cast<size_t>(std::max(farm.workers(), 1)));
+    // 128 points: between two repeats of a point the 127 others of its block run once (some 60
+    // point-lengths on two workers, 25 s in harness/sweeps/simbody.toml), so that a slow spell of
+    // the machine does not last through all of a point's repeats. Such spells are why: the same run
+    // alone took 0.24 CPU s or 0.37-0.39 s, in spells of one to nine runs (2 to 5 s), with no steal
+    // time and on either core (BENCHMARKS.md, "A point's repeats"); in blocks of 32, three points
+    // still drew the slow speed in all three rounds. An interrupted sweep runs at most a block's
+    // points again. Four per worker on a larger farm, so that a block keeps every worker busy.
+    const size_t block = std::max<size_t>(128, 4 * static_cast<size_t>(std::max(farm.workers(), 1)));
     const std::vector<SweepTask> tasks = repeat_schedule(prep.todo.size(), repeats, block);
     std::unique_ptr<RecordAppender> appender;
     std::unique_ptr<SweepProgress> progress;

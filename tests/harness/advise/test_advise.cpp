@@ -217,6 +217,42 @@ TEST(OneCriterion, SearchSentenceAndAdviceAgreeOnTheSameRecords) {
   EXPECT_FALSE(e.chosen);
 }
 
+// The advice is the cheapest confirmed configuration; those confirmed safe within 10 % of its
+// CPU time are named beside it (as the sweep page names its ties), cheapest first; one 20 % dearer
+// and one whose confirming run is not safe are not.
+TEST(OneCriterion, AdviceNamesTheConfigurationsItDoesNotTellApart) {
+  AdviceEngine e;
+  e.engine = "mujoco";
+  e.knob = "timestep";
+  std::vector<SweepRecord> confirm;
+  const std::vector<std::pair<double, std::string>> runs = {{1.0, "ok"}, {1.2, "ok"}, {1.08, "ok"}, {1.02, "unphysical"}, {1.05, "ok"}};
+  for (size_t i = 0; i < runs.size(); ++i) {
+    AdviceConfig cfg;
+    cfg.engine = "mujoco";
+    cfg.setup = "mujoco-" + std::to_string(i);
+    cfg.keys = {"cone"};
+    cfg.values = {"\"c" + std::to_string(i) + "\""};
+    e.configs.push_back(cfg);
+    SearchBoundary b;
+    b.status = "found";
+    b.boundary = 1e-3;
+    e.boundaries.push_back(b);
+    SweepRecord r = rec(5e-4, runs[i].first, runs[i].second, 0.001);
+    r.setup = cfg.setup;
+    confirm.push_back(r);
+  }
+  choose_advice(e, parse_criterion("regime and inversion within 1%"), confirm);
+  ASSERT_TRUE(e.chosen);
+  EXPECT_EQ(*e.chosen, 0u);
+  ASSERT_EQ(e.ties.size(), 2u);
+  EXPECT_EQ(e.ties[0].config, 4u);
+  EXPECT_EQ(e.ties[1].config, 2u);
+  EXPECT_EQ(advice_ties_text(e), (std::vector<std::string>{"cone = c4, timestep 0.0005 (1.05 CPU s)",
+                                                           "cone = c2, timestep 0.0005 (1.08 CPU s)"}));
+  EXPECT_EQ(advice_record(AdviceResult{"s", "c", true, 10.0, 1.0, {e}, 5, false}).engines.at(0).near_ties,
+            advice_ties_text(e));
+}
+
 TEST(OneCriterion, ParsesAndPrintsItsTerms) {
   const SearchCriterion c = parse_criterion("regime and inversion within 1% and tilt_rms_error <= 0.05");
   EXPECT_TRUE(c.regime);

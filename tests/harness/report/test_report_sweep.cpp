@@ -83,6 +83,24 @@ TEST(SweepVerdict, RegimeErrorAndTheSettingToUse) {
   EXPECT_EQ(md.rfind("[all reports](../index.html) · [records.jsonl](records.jsonl)", 0), 0u) << md.substr(0, 200);
 }
 
+// A second point safe within 1 % at a CPU time within 10 % of the cheapest's is named beside the
+// answer, in the verdict and in the cheapest-setting table; the answer stays the cheapest.
+TEST(SweepVerdict, ANearTieInCostIsNamedBesideTheAnswer) {
+  std::vector<SweepRecord> recs = fixture();
+  recs[2].cpu_seconds = 1.05;  // 0.01 %, 5 % dearer than the 0.5 % point
+  const std::string md = render_sweep_markdown(recs);
+  const std::string v = verdict_line(md, "ode");
+  EXPECT_NE(v.find("on inverting ode timestep = 0.001 (the cheapest safe within 1 %: 0.5 %, 1 CPU s) (within 10 % of its "
+                   "CPU time, not told apart: ode timestep = 0.0001 1.05 s)"),
+            std::string::npos)
+      << v;
+  EXPECT_NE(md.find("| ode | 1 % | ode | engines.ode.timestep = 0.001 | 0.5 % | 1 | ode timestep = 0.0001: 1.05 s |"),
+            std::string::npos)
+      << md;
+  // Without the tie, no such words.
+  EXPECT_EQ(render_sweep_markdown(fixture()).find("not told apart:"), std::string::npos);
+}
+
 TEST(SweepVerdict, AnUnphysicalOrDivergedPointIsNeverRecommended) {
   std::vector<SweepRecord> recs = fixture();
   recs[1].run_class = "unphysical";  // the cheapest below 1 %, but its conservation law broke

@@ -105,6 +105,24 @@ TEST(SweepAnalysis, CheapestSettingBelowEachBound) {
   EXPECT_EQ(cheapest_at_least_as_accurate(an, 1e-10), -1);
 }
 
+// Points safe by the same criterion within 10 % of the cheapest's CPU time are named beside it,
+// cheapest first; an unsafe point, a point outside the bound or one 10.1 % dearer is not.
+TEST(SweepAnalysis, CostTiesAreTheSafePointsWithinTenPercent) {
+  std::vector<SweepRecord> a = {point("a", "a-euler", 1e-3, 1.00, 0.005), point("a", "a-rk4", 1e-2, 1.08, 0.004),
+                                point("a", "a-euler", 1e-4, 1.05, 0.002), point("a", "a-rk4", 1e-3, 1.101, 0.0002),
+                                point("a", "a-bad", 1e-3, 1.02, 0.001, "diverged"),
+                                point("a", "a-late", 1e-3, 1.03, 0.05)};
+  const SearchCriterion c = setting_criterion(true, 0.01);
+  const long long best = cheapest_safe(a, c);
+  ASSERT_EQ(best, 0);
+  EXPECT_EQ(cost_ties(a, best, c), (std::vector<size_t>{2, 1}));
+  // Under the 10 % bound the late point qualifies, and is within 10 %.
+  EXPECT_EQ(cost_ties(a, cheapest_safe(a, setting_criterion(true, 0.1)), setting_criterion(true, 0.1)),
+            (std::vector<size_t>{5, 2, 1}));
+  EXPECT_TRUE(cost_ties(a, -1, c).empty());
+  EXPECT_TRUE(cost_ties({a[0]}, 0, c).empty());
+}
+
 TEST(SweepAnalysis, SoftestSettingInTheReferencesRegime) {
   // The reference rolls (no inversion): a point agrees when it finishes without inverting.
   auto rolling = [](double dt, std::optional<double> inversion, const std::string& status = "ok") {
