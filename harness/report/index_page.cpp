@@ -57,7 +57,7 @@ DocTable sweep_matrix(const IndexSweep& sw, const std::string& page) {
         // A near tie is part of the answer: the cell names how many, the page names them.
         if (!u.ties.empty())
           text += "; " + std::to_string(u.ties.size()) + " other" + (u.ties.size() > 1 ? "s" : "") + " within " +
-                  pct(kCostResolution);
+                  pct(kCostResolution) + " of its CPU time";
         row.push_back(DocCell(text, "v-" + u.tier, sw.dir + "/" + page));
       }
     }

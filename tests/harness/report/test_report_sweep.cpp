@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "harness/report/gnuplot.h"
+#include "harness/report/document.h"
 #include "harness/report/report.h"
 #include "harness/sweep/sweep.h"
 #include "tests/support/files.h"
@@ -99,6 +100,13 @@ TEST(SweepVerdict, ANearTieInCostIsNamedBesideTheAnswer) {
       << md;
   // Without the tie, no such words.
   EXPECT_EQ(render_sweep_markdown(fixture()).find("not told apart:"), std::string::npos);
+  // The index's cell of the sweep's matrix counts it, in words apart from the error's 10 % tier.
+  const std::string index = render_document_markdown(index_document(IndexInput{{}, {{"sweep-x", "d", recs}}}, "report.md"));
+  EXPECT_NE(index.find("timestep = 0.001 (0.5 %), 1 CPU s; 1 other within 10 % of its CPU time"), std::string::npos)
+      << index;
+  EXPECT_EQ(render_document_markdown(index_document(IndexInput{{}, {{"sweep-x", "d", fixture()}}}, "report.md"))
+                .find("within 10 % of its CPU time"),
+            std::string::npos);
 }
 
 TEST(SweepVerdict, AnUnphysicalOrDivergedPointIsNeverRecommended) {
