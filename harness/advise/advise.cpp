@@ -198,8 +198,10 @@ std::vector<std::string> advice_ties_text(const AdviceEngine& e) {
 
 void choose_advice(AdviceEngine& e, const SearchCriterion& criterion, const std::vector<SweepRecord>& confirm) {
   e.chosen.reset();
-  double best = 0;
+  e.ties.clear();
   size_t safe_boundaries = 0;
+  // The configurations with a safe boundary whose confirming run is safe, in order.
+  std::vector<std::pair<size_t, const SweepRecord*>> confirmed;
   for (size_t i = 0; i < e.configs.size() && i < e.boundaries.size(); ++i) {
     const SearchBoundary& b = e.boundaries[i];
     if ((b.status != "found" && b.status != "all_safe") || !b.boundary) continue;
@@ -207,28 +209,29 @@ void choose_advice(AdviceEngine& e, const SearchCriterion& criterion, const std:
     const auto r = std::find_if(confirm.begin(), confirm.end(),
                                 [&](const SweepRecord& x) { return x.setup == e.configs[i].setup; });
     if (r == confirm.end() || !is_safe(criterion, *r) || !std::isfinite(r->cpu_seconds)) continue;
-    if (!e.chosen || r->cpu_seconds < best) {
+    confirmed.emplace_back(i, &*r);
+  }
+  // The cheapest (the first of equals), then those the machine's noise could have chosen instead.
+  const SweepRecord* best = nullptr;
+  for (const auto& [i, r] : confirmed)
+    if (!best || r->cpu_seconds < best->cpu_seconds) {
       e.chosen = i;
-      best = r->cpu_seconds;
-      e.step = r->ladder_value;
-      e.boundary = *b.boundary;
-      e.beyond = b.beyond ? *b.beyond : 0;
-      e.cpu_seconds = r->cpu_seconds;
-      e.confirm_point = r->point_id;
+      best = r;
     }
+  if (best) {
+    const SearchBoundary& b = e.boundaries[*e.chosen];
+    e.step = best->ladder_value;
+    e.boundary = *b.boundary;
+    e.beyond = b.beyond ? *b.beyond : 0;
+    e.cpu_seconds = best->cpu_seconds;
+    e.confirm_point = best->point_id;
+    for (const auto& [i, r] : confirmed)
+      if (i != *e.chosen && within_cost_resolution(r->cpu_seconds, best->cpu_seconds))
+        e.ties.push_back({i, r->ladder_value, r->cpu_seconds});
+    std::stable_sort(e.ties.begin(), e.ties.end(), [](const AdviceEngine::Tie& a, const AdviceEngine::Tie& b) {
+      return a.cpu_seconds < b.cpu_seconds;
+    });
   }
-  // The configurations the machine's noise could have chosen instead (sweep_analysis.h, kCostResolution).
-  e.ties.clear();
-  for (size_t i = 0; e.chosen && i < e.configs.size() && i < e.boundaries.size(); ++i) {
-    const SearchBoundary& b = e.boundaries[i];
-    if (i == *e.chosen || (b.status != "found" && b.status != "all_safe") || !b.boundary) continue;
-    const auto r = std::find_if(confirm.begin(), confirm.end(),
-                                [&](const SweepRecord& x) { return x.setup == e.configs[i].setup; });
-    if (r == confirm.end() || !is_safe(criterion, *r) || !std::isfinite(r->cpu_seconds)) continue;
-    if (r->cpu_seconds <= best * (1 + kCostResolution)) e.ties.push_back({i, r->ladder_value, r->cpu_seconds});
-  }
-  std::stable_sort(e.ties.begin(), e.ties.end(),
-                   [](const AdviceEngine::Tie& a, const AdviceEngine::Tie& b) { return a.cpu_seconds < b.cpu_seconds; });
   if (!e.chosen) {
     if (e.configs.empty()) e.reason = "no configuration searched (the run budget, --max-runs, allows none)";
     else if (safe_boundaries == 0) {

@@ -140,10 +140,10 @@ long long cheapest_safe(const std::vector<SweepRecord>& records, const SearchCri
 std::vector<size_t> cost_ties(const std::vector<SweepRecord>& records, long long best, const SearchCriterion& c) {
   std::vector<size_t> ties;
   if (best < 0) return ties;
-  const double bound = records[static_cast<size_t>(best)].cpu_seconds * (1 + kCostResolution);
+  const double cheapest = records[static_cast<size_t>(best)].cpu_seconds;
   for (size_t i = 0; i < records.size(); ++i)
     if (static_cast<long long>(i) != best && is_safe(c, records[i]) && std::isfinite(records[i].cpu_seconds) &&
-        records[i].cpu_seconds <= bound)
+        within_cost_resolution(records[i].cpu_seconds, cheapest))
       ties.push_back(i);
   std::stable_sort(ties.begin(), ties.end(),
                    [&](size_t a, size_t b) { return records[a].cpu_seconds < records[b].cpu_seconds; });

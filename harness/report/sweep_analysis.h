@@ -32,6 +32,8 @@ long long cheapest_safe(const std::vector<SweepRecord>& records, const SearchCri
 // interleaved repeats are, ranged 0.232-0.250 (7.8 %), that of three back to back 0.232-0.333
 // (BENCHMARKS.md, "A point's repeats").
 inline constexpr double kCostResolution = 0.10;
+// Whether a CPU time is not told apart from the cheapest's: cpu <= cheapest * (1 + kCostResolution).
+inline bool within_cost_resolution(double cpu, double cheapest) { return cpu <= cheapest * (1 + kCostResolution); }
 // The other points of `records` safe under `c` whose CPU time is within kCostResolution of
 // records[best]'s (best: cheapest_safe's answer), cheapest first; empty when best < 0. The
 // cheapest is the answer; these are named beside it, as the machine's noise could have chosen them.
