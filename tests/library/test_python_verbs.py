@@ -9,6 +9,7 @@ import json
 import math
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -271,13 +272,17 @@ def test_import_advise(exe, src, tmp):
     printed = cli(exe, "advise", str(tmp / "cli.toml"), "--out", str(tmp / "adv-cli"), *args).stdout
     a = tippe.advise(str(tmp / "py.toml"), out=str(tmp / "adv-py"), engines=["ode"], max_runs=12, duration=0.3,
                      step_from=1e-3, resolution=0.3, progress=False)
-    cpu = lambda text: re.sub(r"[0-9.e+-]+ CPU s", "X CPU s", text)
-    check(f"str(advice) is the command's lines: {str(a)!r}", cpu(str(a)) == cpu(printed.split("\nruns:")[0]))
     check("advice fields", a.engines[0].engine == "ode" and a.runs == int(re.search(r"runs: (\d+)", printed)[1]))
-    gate_py, gate_cli = (tmp / "adv-py/advice.toml").read_text(), (tmp / "adv-cli/advice.toml").read_text()
+    # The advice is the cheapest configuration by CPU time, and which one that is (and which others
+    # are within 10 % of it) can differ between two runs of the search when costs are near: the
+    # verb and the command are compared on the same records, a copy of the command's directory,
+    # which the verb resumes (every run already there) to the same advice.
+    shutil.copytree(tmp / "adv-cli", tmp / "adv-same")
+    same = tippe.advise(str(tmp / "cli.toml"), out=str(tmp / "adv-same"), engines=["ode"], max_runs=12, duration=0.3,
+                        step_from=1e-3, resolution=0.3, progress=False)
+    check(f"str(advice) is the command's lines: {str(same)!r}", str(same) == printed.split("\nruns:")[0])
     check("advice.toml as the command writes it",
-          cpu(gate_py).replace("py.toml", "S").replace("for py ", "for S ") ==
-          cpu(gate_cli).replace("cli.toml", "S").replace("for cli ", "for S "))
+          (tmp / "adv-same/advice.toml").read_text() == (tmp / "adv-cli/advice.toml").read_text())
     # A scene object (a dict) is written for the advice's own files.
     check("advise(Scene) runs", tippe.advise(mem, out=str(tmp / "adv-mem"), engines=["ode"], max_runs=12,
                                              duration=0.3, step_from=1e-3, resolution=0.3, progress=False).runs > 0)
