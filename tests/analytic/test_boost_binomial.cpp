@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+namespace test_boost_binomial {
+
 // Boost 1.74's formula for binomial_coefficient<double>, written out: n! / (n-k)! / k! in double
 // from long double factorials, rounded to the nearest integer. Equality is exact (==): the
 // replacement exists only to be bit-identical and faster.
@@ -29,3 +31,5 @@ TEST(BoostBinomial, SmallCoefficientsAreExact) {
   EXPECT_EQ(boost::math::binomial_coefficient<double>(30, 15), 155117520.0);
   EXPECT_EQ(boost::math::binomial_coefficient<double>(5, 2), 10.0);
 }
+
+}  // namespace test_boost_binomial

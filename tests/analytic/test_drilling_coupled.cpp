@@ -15,7 +15,7 @@
 #include "tests/support/reference_runs.h"
 #include "engines/core/simulator.h"
 
-namespace tippe {
+namespace tippe::test_drilling_coupled {
 namespace {
 
 Scene shipped(const std::string& name) { return load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/" + name + ".toml"); }

@@ -12,7 +12,7 @@
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
 
-namespace tippe {
+namespace tippe::test_impact_drilling {
 namespace {
 
 Scene shipped(const std::string& name) { return load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/" + name + ".toml"); }

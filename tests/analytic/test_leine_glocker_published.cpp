@@ -12,7 +12,7 @@
 #include "tests/support/fixtures.h"
 #include "tests/support/reference_runs.h"
 
-namespace tippe {
+namespace tippe::test_leine_glocker_published {
 namespace {
 
 using fixtures::first_event;

@@ -22,7 +22,7 @@
 
 #include "analytic/mass_properties.h"
 
-namespace tippe {
+namespace tippe::test_mass_properties {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;

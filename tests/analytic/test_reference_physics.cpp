@@ -10,7 +10,7 @@
 #include "tests/support/fixtures.h"
 #include "analytic/contact_dynamics.h"
 
-namespace tippe {
+namespace tippe::test_reference_physics {
 namespace {
 
 // The source's dimensionless top (REFERENCE_VALUES.md): g = 1, M = 1, A = 0.4, C = 0.45, d = 0.3.

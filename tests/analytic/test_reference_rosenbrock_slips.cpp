@@ -4,7 +4,7 @@
 #include "tests/support/fixtures.h"
 #include "tests/support/reference_runs.h"
 
-namespace tippe {
+namespace tippe::test_reference_rosenbrock_slips {
 namespace {
 
 // rosenbrock4 on the Leine-Glocker top at mu = 0.02 from a tilt of 1 rad, with the checks and

@@ -9,7 +9,7 @@
 #include "harness/scene/resolve.h"
 #include "harness/measure/run.h"
 
-namespace tippe {
+namespace tippe::test_reference_sampling {
 namespace {
 
 RunRecord run_at(const std::string& scene, double duration, double interval) {

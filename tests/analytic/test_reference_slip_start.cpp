@@ -14,7 +14,7 @@
 #include "tests/support/fixtures.h"
 #include "tests/support/reference_runs.h"
 
-namespace tippe {
+namespace tippe::test_reference_slip_start {
 namespace {
 
 Scene shipped(const std::string& name) { return load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/" + name + ".toml"); }

@@ -15,7 +15,7 @@
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
 
-namespace tippe {
+namespace tippe::test_reference_stiff {
 namespace {
 
 const std::string kScene = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/toy_viscous.toml";

@@ -15,7 +15,7 @@
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
 
-namespace tippe {
+namespace tippe::test_reference_touchdown {
 namespace {
 
 Scene scene_file(const std::string& rel, const std::string& method, double rtol) {

@@ -14,7 +14,7 @@
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
 
-namespace tippe {
+namespace tippe::test_reference_touchdown_methods {
 namespace {
 
 struct Event {
@@ -111,7 +111,7 @@ TEST(ReferenceTouchdownMethods, TiltNearPiWholeRun) { expect_same_sequence("extr
 }  // namespace
 }  // namespace tippe
 
-namespace tippe {
+namespace tippe::test_reference_touchdown_methods {
 namespace {
 
 // Why the methods' impact times part by up to ~7e-6 at rtol 1e-8 (the 5e-5 above): the state

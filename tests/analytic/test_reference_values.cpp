@@ -7,7 +7,7 @@
 #include "analytic/initial_state.h"
 #include "analytic/reference_model.h"
 
-namespace tippe {
+namespace tippe::test_reference_values {
 namespace {
 
 Scene seed_scene(FrictionLaw law, double k, double spin, double duration, double rtol = 1e-12) {

@@ -17,7 +17,7 @@
 #include "engines/core/simulator.h"
 #include "tests/support/fixtures.h"
 
-namespace tippe {
+namespace tippe::test_bullet {
 namespace {
 
 using namespace fixtures;

@@ -17,7 +17,7 @@
 #include "engines/core/registry.h"
 #include "tests/support/fixtures.h"
 
-namespace tippe {
+namespace tippe::test_conformance {
 namespace {
 
 // ---- Tolerances -----------------------------------------------------------------------------
@@ -28,7 +28,7 @@ namespace {
 // floored at kRoundOff (a residual of exactly 0 would otherwise allow nothing).
 //
 // Recipe (recalibrating after an engine or default-setting change, or for a new engine):
-//   TIPPE_CONFORMANCE_SCALE=1e12 ./build/tests/test_conformance --gtest_filter='Engines/*NEW*' | grep residual
+//   TIPPE_CONFORMANCE_SCALE=1e12 ./build/tests/test_engines --gtest_filter='Engines/*NEW*' | grep residual
 // prints every residual (the huge scale lets every check pass); enter each, rounded UP to two
 // significant digits, in the engine's row. TIPPE_CONFORMANCE_SCALE (default 10) is the knob:
 // e.g. 2 shows how close each engine runs to its calibration.

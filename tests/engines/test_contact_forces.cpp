@@ -13,7 +13,7 @@
 #include "engines/core/simulator.h"
 #include "tests/support/fixtures.h"
 
-namespace tippe {
+namespace tippe::test_contact_forces {
 namespace {
 
 // One row per engine: the bound of each check and where it comes from. A row that fails a check

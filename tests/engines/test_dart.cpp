@@ -15,7 +15,7 @@
 #include "tests/support/fixtures.h"
 #include "tests/support/mapped_files.h"
 
-namespace tippe {
+namespace tippe::test_dart {
 namespace {
 
 Scene with_detector(Scene s, const std::string& detector) {

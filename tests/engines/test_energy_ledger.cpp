@@ -17,7 +17,7 @@
 #include "engines/core/simulator.h"
 #include "tests/support/fixtures.h"
 
-namespace tippe {
+namespace tippe::test_energy_ledger {
 namespace {
 
 namespace fs = std::filesystem;

@@ -16,7 +16,7 @@
 #include "engines/core/step_checks.h"
 #include "tests/support/fixtures.h"
 
-namespace tippe {
+namespace tippe::test_energy_ledger_steps {
 namespace {
 
 Eigen::Matrix3d inertia_W(const BodyModel& b, const Quat& q) {

@@ -21,6 +21,8 @@
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
 
+namespace test_engine_loading {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -273,3 +275,5 @@ TEST(EngineProcess, SiconosRunStartsNoBlasThreadTeam) {
   EXPECT_EQ(unset.most, one.most) << "without OPENBLAS_NUM_THREADS, a Siconos run had " << unset.most
                                   << " threads at most, against " << one.most << " with it at 1";
 }
+
+}  // namespace test_engine_loading

@@ -18,7 +18,7 @@
 #include "engines/core/simulator.h"
 #include "tests/support/reference_runs.h"
 
-namespace tippe {
+namespace tippe::test_gliding {
 namespace {
 
 Scene gliding_ball() { return load_scene(std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/rutstam_gliding_ball.toml"); }

@@ -29,7 +29,7 @@
 #include "engines/core/simulator.h"
 #include "tests/support/process.h"
 
-namespace tippe {
+namespace tippe::test_import_mjcf {
 namespace {
 
 namespace fs = std::filesystem;

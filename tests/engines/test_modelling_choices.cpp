@@ -10,7 +10,7 @@
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
 
-namespace tippe {
+namespace tippe::test_modelling_choices {
 namespace {
 
 const std::string kScenes = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/";

@@ -20,7 +20,7 @@
 #include "engines/core/simulator.h"
 #include "tests/support/fixtures.h"
 
-namespace tippe {
+namespace tippe::test_mujoco {
 namespace {
 
 using namespace fixtures;

@@ -27,7 +27,7 @@
 #include "harness/scene/resolve.h"
 #include "engines/core/simulator.h"
 
-namespace tippe {
+namespace tippe::test_mujoco_tutorial {
 namespace {
 
 const std::string kXml = std::string(TIPPE_SOURCE_DIR) + "/tests/data/mujoco_tutorial_top.xml";

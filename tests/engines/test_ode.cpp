@@ -15,7 +15,7 @@
 #include "engines/core/simulator.h"
 #include "tests/support/fixtures.h"
 
-namespace tippe {
+namespace tippe::test_ode {
 namespace {
 
 using namespace fixtures;

@@ -13,7 +13,7 @@
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
 
-namespace tippe {
+namespace tippe::test_two_contact_friction {
 namespace {
 
 const std::string kScene = std::string(TIPPE_SOURCE_DIR) + "/harness/scenes/extremes/tilt_near_pi.toml";

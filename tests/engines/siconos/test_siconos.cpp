@@ -22,7 +22,7 @@
 #include "harness/scene/resolve.h"
 #include "engines/core/registry.h"
 
-namespace tippe {
+namespace tippe::test_siconos {
 namespace {
 
 // The first-order estimate is a model of the error, not a bound: its constant drifts between

@@ -12,7 +12,7 @@
 #include "engines/core/registry.h"
 #include "tests/support/fixtures.h"
 
-namespace tippe {
+namespace tippe::test_simbody {
 namespace {
 
 TEST(Simbody, RestsAtTheHertzDepthOfItsStiffness) {

@@ -17,6 +17,8 @@
 #include "tests/support/process.h"
 #include "harness/sweep/sweep_search.h"
 
+namespace test_advise {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -316,3 +318,5 @@ TEST(AdviceRecord, WritesExactlyItsListedFields) {
   EXPECT_EQ(o.at("reason"), none.reason);
   EXPECT_TRUE(j.at("reference_inversion_time").is_null());
 }
+
+}  // namespace test_advise

@@ -11,7 +11,7 @@
 #include "tests/support/files.h"
 #include "tests/support/process.h"
 
-namespace tippe {
+namespace tippe::test_cli_conventions {
 namespace {
 
 namespace fs = std::filesystem;

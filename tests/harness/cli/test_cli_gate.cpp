@@ -17,6 +17,8 @@
 #include "tests/support/gate_fixtures.h"
 #include "tests/support/xml_reader.h"
 
+namespace test_cli_gate {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -261,3 +263,5 @@ TEST(GateCommand, ShippedDefaultGatesPass) {
   const std::string n = std::to_string(2 * engine_names().size());
   EXPECT_NE(e.out.find("gate: " + n + " of " + n + " checks passed"), std::string::npos) << e.out;
 }
+
+}  // namespace test_cli_gate

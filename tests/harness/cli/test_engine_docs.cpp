@@ -8,6 +8,8 @@
 #include "tests/support/files.h"
 #include "tests/support/process.h"
 
+namespace test_engine_docs {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -47,3 +49,5 @@ TEST(EngineDocs, EverySettingOfEveryEngineIsListed) {
 }
 
 }  // namespace
+
+}  // namespace test_engine_docs

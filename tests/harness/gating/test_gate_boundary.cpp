@@ -8,6 +8,8 @@
 #include "harness/sweep/sweep_search.h"
 #include "tests/support/sweep_searches.h"
 
+namespace test_gate_boundary {
+
 using namespace tippe;
 
 namespace {
@@ -48,3 +50,5 @@ TEST(SweepSearchGate, BoundaryCheckJudgesTheSearchFromRecords) {
   c.scene = "toy";
   EXPECT_FALSE(evaluate_boundary(c, records).passed);
 }
+
+}  // namespace test_gate_boundary

@@ -8,6 +8,8 @@
 #include "harness/gating/gate.h"
 #include "tests/support/gate_fixtures.h"
 
+namespace test_gate_check {
+
 using namespace tippe;
 using nlohmann::json;
 
@@ -282,3 +284,5 @@ TEST(GateEvaluate, RequireNoWrongEvent) {
   EXPECT_FALSE(r.passed);
   EXPECT_EQ(row(r, "first_wrong_event")->measured, "absent");
 }
+
+}  // namespace test_gate_check

@@ -10,6 +10,8 @@
 #include "tests/support/files.h"
 #include "tests/support/gate_fixtures.h"
 
+namespace test_gate_file {
+
 using namespace tippe;
 
 namespace {
@@ -142,3 +144,5 @@ require_no_wrong_event = false
     }
   }
 }
+
+}  // namespace test_gate_file

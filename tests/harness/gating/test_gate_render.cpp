@@ -15,6 +15,8 @@
 #include "tests/support/gate_fixtures.h"
 #include "tests/support/xml_reader.h"
 
+namespace test_gate_render {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -166,3 +168,5 @@ TEST(GateRender, JsonResultIsTheFieldListsAndTheSchemaDescribesThem) {
   EXPECT_EQ(keys_of(row.at("properties")), row_keys);
   EXPECT_EQ(row.at("properties").at("kind").at("enum"), json(gate_row_kind_names()));
 }
+
+}  // namespace test_gate_render

@@ -10,7 +10,7 @@
 
 #include "harness/io/g17.h"
 
-namespace tippe {
+namespace tippe::test_g17 {
 namespace {
 
 std::string reference_text(double v) {

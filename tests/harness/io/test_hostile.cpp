@@ -43,6 +43,8 @@
 #include "tests/support/files.h"
 #include "tests/support/process.h"
 
+namespace test_hostile {
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -459,3 +461,5 @@ INSTANTIATE_TEST_SUITE_P(Table, Hostile, ::testing::ValuesIn(all_cases()),
                          [](const ::testing::TestParamInfo<Case>& info) { return info.param.name; });
 
 }  // namespace
+
+}  // namespace test_hostile

@@ -12,6 +12,8 @@
 #include "tests/support/files.h"
 #include "tests/support/fixtures.h"
 
+namespace test_input_table {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 
@@ -235,3 +237,5 @@ TEST(InputTable, InMemoryParserTouchesNoFile) {
 }
 
 }  // namespace
+
+}  // namespace test_input_table

@@ -16,6 +16,8 @@
 #include "tests/support/files.h"
 #include "tests/support/process.h"
 
+namespace test_output_dir {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 
@@ -288,3 +290,5 @@ TEST(ResultFile, AnUnwritableJunitIsFoundBeforeTheGateRuns) {
   // A gate that ran would take seconds (30 s of the toy top on ODE and the reference).
   EXPECT_LT(seconds, 5.0) << "the gate ran before the path was checked";
 }
+
+}  // namespace test_output_dir

@@ -18,6 +18,8 @@
 #include "tests/support/files.h"
 #include "tests/support/process.h"
 
+namespace test_output_ownership {
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -215,3 +217,5 @@ TEST(OutputOwnership, ASymbolicLinkInAReportsDirectoryIsReadThrough) {
   for (const auto& entry : fs::directory_iterator(data)) in_data.push_back(entry.path().filename().string());
   EXPECT_EQ(in_data, std::vector<std::string>{"ode.csv"});
 }
+
+}  // namespace test_output_ownership

@@ -12,6 +12,8 @@
 #include "harness/scene/resolve.h"
 #include "harness/sweep/sweep.h"
 
+namespace test_reference_settings_spelling {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -94,3 +96,5 @@ TEST(ReferenceSettingsSpelling, OverridesOnAShippedScene) {
 }
 
 }  // namespace
+
+}  // namespace test_reference_settings_spelling

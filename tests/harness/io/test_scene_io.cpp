@@ -16,6 +16,8 @@
 #include "tests/support/files.h"
 #include "tests/support/fixtures.h"
 
+namespace test_scene_io {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 
@@ -314,3 +316,5 @@ TEST(Cli, UnknownEngineAndMissingFileExitWithTwo) {
 }
 
 }  // namespace
+
+}  // namespace test_scene_io

@@ -10,7 +10,7 @@
 #include "harness/io/scene_io.h"
 #include "harness/scene/resolve.h"
 
-namespace tippe {
+namespace tippe::test_shipped_scenes {
 namespace {
 
 std::vector<std::string> shipped_scenes() {

@@ -13,6 +13,8 @@
 #include "tests/support/process.h"
 #include "tests/support/fixtures.h"
 
+namespace test_toml_reader {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 
@@ -292,3 +294,5 @@ INSTANTIATE_TEST_SUITE_P(Files, FileTable, ::testing::ValuesIn(file_cases()),
                          });
 
 }  // namespace
+
+}  // namespace test_toml_reader

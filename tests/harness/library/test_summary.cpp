@@ -15,7 +15,7 @@
 #include "tests/support/field_filler.h"
 #include "tests/support/files.h"
 
-namespace tippe {
+namespace tippe::test_summary {
 namespace {
 
 namespace fs = std::filesystem;

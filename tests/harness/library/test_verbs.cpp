@@ -16,7 +16,7 @@
 #include "engines/core/registry.h"
 #include "tests/support/fixtures.h"
 
-namespace tippe {
+namespace tippe::test_verbs {
 namespace {
 
 namespace fs = std::filesystem;

@@ -13,7 +13,7 @@
 #include "harness/scene/resolve.h"
 #include "tests/support/classify_fixtures.h"
 
-namespace tippe {
+namespace tippe::test_classify {
 namespace {
 
 // Samples at t = 0, 0.1, ...: E falls slowly from 10, J = -2, tilt grows, on the ball.

@@ -17,6 +17,8 @@
 #include "tests/support/files.h"
 #include "tests/support/html_check.h"
 
+namespace test_compare {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -129,3 +131,5 @@ TEST(RunComparison, TheReferenceAgainstItselfHasNoError) {
   EXPECT_GT(c.engines[1].metrics.steps, 0);
   EXPECT_FALSE(c.reference_cached);
 }
+
+}  // namespace test_compare

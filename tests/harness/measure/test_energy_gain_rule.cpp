@@ -14,7 +14,7 @@
 #include "harness/scene/resolve.h"
 #include "tests/support/classify_fixtures.h"
 
-namespace tippe {
+namespace tippe::test_energy_gain_rule {
 namespace {
 
 // A run whose E rises by 1e-3 E0 over t = 0.5 .. 1.0 while its ledger books `booked` of it

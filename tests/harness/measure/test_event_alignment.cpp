@@ -10,6 +10,8 @@
 #include "harness/records/comparison.h"
 #include "tests/support/files.h"
 
+namespace test_event_alignment {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -249,3 +251,5 @@ TEST(EventAlignment, ShippedSceneComparisonCarriesConsistentFields) {
   EXPECT_NE(report.find("## Event sequences"), std::string::npos);
   EXPECT_NE(report.find("| engine | reference | engine events | matched | missing | extra |"), std::string::npos);
 }
+
+}  // namespace test_event_alignment

@@ -19,6 +19,8 @@
 #include "tests/support/files.h"
 #include "harness/report/sweep_analysis.h"
 
+namespace test_extremes {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -205,3 +207,5 @@ TEST(ExtremesStart, TiltIsExactNearVerticalAndInverted) {
   }
   EXPECT_EQ(tilt(Quat::Identity()), 0.0);
 }
+
+}  // namespace test_extremes

@@ -17,6 +17,8 @@
 #include "tests/support/compare_fixtures.h"
 #include "tests/support/files.h"
 
+namespace test_metrics {
+
 using namespace tippe;
 using nlohmann::json;
 
@@ -333,3 +335,5 @@ TEST(Trajectories, FromCsvNamesAMissingColumn) {
   csv.surface = {1};
   EXPECT_THROW(Trajectory::from_csv(csv), std::out_of_range);
 }
+
+}  // namespace test_metrics

@@ -10,6 +10,8 @@
 #include "harness/records/records.h"
 #include "tests/support/observations.h"
 
+namespace test_run {
+
 using namespace tippe;
 
 namespace {
@@ -95,3 +97,5 @@ TEST(Records, RunSimulatorReachesDuration) {
 }
 
 }  // namespace
+
+}  // namespace test_run

@@ -13,6 +13,8 @@
 #include "harness/scene/resolve.h"
 #include "tests/support/files.h"
 
+namespace test_self_check {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -308,3 +310,5 @@ TEST(SelfCheck, RecordsWithoutItStillRead) {
 }
 
 }  // namespace
+
+}  // namespace test_self_check

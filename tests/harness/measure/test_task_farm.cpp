@@ -11,6 +11,8 @@
 
 #include "harness/measure/task_farm.h"
 
+namespace test_task_farm {
+
 using namespace tippe;
 
 TEST(TaskFarm, ThreadFarmRunsEveryTaskOnceAndHandsResultsOverOneAtATime) {
@@ -62,3 +64,5 @@ TEST(TaskFarm, ThreadFarmRethrowsTheFirstErrorAfterTheTasksRunning) {
   EXPECT_EQ(first_error(*farm, ""), "");
   EXPECT_EQ(first_error(*farm, "mine"), "mine");
 }
+
+}  // namespace test_task_farm

@@ -20,6 +20,8 @@
 #include "tests/support/field_filler.h"
 #include "tests/support/files.h"
 
+namespace test_record_fields {
+
 namespace {
 
 using namespace tippe;
@@ -191,3 +193,5 @@ TEST(RecordFields, EveryVisitedFieldIsAPropertyOfItsSchema) {
 }
 
 }  // namespace
+
+}  // namespace test_record_fields

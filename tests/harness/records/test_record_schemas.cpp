@@ -22,6 +22,8 @@
 #include "harness/records/sweep_record.h"
 #include "tests/support/files.h"
 
+namespace test_record_schemas {
+
 namespace {
 
 using namespace tippe;
@@ -157,3 +159,5 @@ TEST(RecordSchemas, TheGateResultSchemaDescribesEveryKeyWritten) {
 }
 
 }  // namespace
+
+}  // namespace test_record_schemas

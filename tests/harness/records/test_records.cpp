@@ -15,6 +15,8 @@
 #include "tests/support/files.h"
 #include "tests/support/observations.h"
 
+namespace test_records {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 
@@ -305,3 +307,5 @@ TEST(RecordInputs, CountsMustBeIntegers) {
 }
 
 }  // namespace
+
+}  // namespace test_records

@@ -8,6 +8,8 @@
 #include "harness/records/sweep_record.h"
 #include "tests/support/files.h"
 
+namespace test_sweep_record {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -292,3 +294,5 @@ TEST(SweepLadders, GridFieldsReadBackAreCheckedByKey) {
     EXPECT_EQ(std::string(e.what()).rfind(file.string() + ":2: grid.label: \"a b\" is neither", 0), 0u) << e.what();
   }
 }
+
+}  // namespace test_sweep_record

@@ -14,7 +14,7 @@
 #include "tests/support/field_filler.h"
 #include "tests/support/files.h"
 
-namespace tippe {
+namespace tippe::test_sweep_record_fields {
 namespace {
 
 namespace fs = std::filesystem;

@@ -19,6 +19,8 @@
 #include "tests/support/files.h"
 #include "tests/support/html_check.h"
 
+namespace test_compare_report {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -227,3 +229,5 @@ TEST(Report, ChatteringSwitchEventsAreCountedNotListed) {
   EXPECT_EQ(comparison_from_json(j).engines[0].run.inversion_time, 1.0);
   EXPECT_NE(render_html(j, {}).find("<td>150</td>"), std::string::npos);
 }
+
+}  // namespace test_compare_report

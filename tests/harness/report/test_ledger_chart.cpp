@@ -14,6 +14,8 @@
 #include "harness/report/report.h"
 #include "tests/support/files.h"
 
+namespace test_ledger_chart {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -182,3 +184,5 @@ TEST(LedgerChart, ThePageShowsItInTheLedgerSection) {
   EXPECT_FALSE(fs::exists(chart)) << "a stale chart must not stand beside records without a ledger";
   EXPECT_EQ(slurp(dir.path() / "report.md").find(kLedgerChartFile), std::string::npos);
 }
+
+}  // namespace test_ledger_chart

@@ -12,6 +12,8 @@
 #include "tests/support/files.h"
 #include "tests/support/process.h"
 
+namespace test_published_drift {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -197,3 +199,5 @@ TEST(PublishedDrift, TheSweepPointsMatchThePublishedSweepAndAnEditedClassFails) 
 }
 
 }  // namespace
+
+}  // namespace test_published_drift

@@ -15,6 +15,8 @@
 #include "tests/support/page_check.h"
 #include "tests/support/files.h"
 
+namespace test_published_pages {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -251,3 +253,5 @@ TEST_F(BrokenPages, ChromiumCatchesEachBreakage) {
 }
 
 }  // namespace
+
+}  // namespace test_published_pages

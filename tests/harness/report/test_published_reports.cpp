@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+namespace test_published_reports {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -95,3 +97,5 @@ INSTANTIATE_TEST_SUITE_P(Reports, PublishedReport, ::testing::ValuesIn(published
                          [](const auto& info) { return info.param; });
 
 }  // namespace
+
+}  // namespace test_published_reports

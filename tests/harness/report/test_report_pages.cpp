@@ -19,6 +19,8 @@
 #include "harness/io/scene_io.h"
 #include "tests/support/files.h"
 
+namespace test_report_pages {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -419,3 +421,5 @@ TEST(ReportPage, EveryMetricOfTheListIsOnThePage) {
   EXPECT_TRUE(missing.empty()) << "metrics the page does not show: " << ::testing::PrintToString(missing);
   EXPECT_TRUE(shown_after_all.empty()) << "excused but shown: " << ::testing::PrintToString(shown_after_all);
 }
+
+}  // namespace test_report_pages

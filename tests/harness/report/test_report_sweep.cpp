@@ -12,6 +12,8 @@
 #include "tests/support/files.h"
 #include "harness/report/sweep_analysis.h"
 
+namespace test_report_sweep {
+
 using namespace tippe;
 
 namespace {
@@ -176,3 +178,5 @@ TEST(SweepCharts, NamedByTheScenesPlaceAndStaleChartsGo) {
   const std::string html = slurp(dir.path() / "index.html");
   EXPECT_NE(html.find("<img src=\"wp-s1-inversion_time_rel_error.svg\""), std::string::npos);
 }
+
+}  // namespace test_report_sweep

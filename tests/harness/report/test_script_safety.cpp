@@ -12,6 +12,8 @@
 #include "tests/support/files.h"
 #include "tests/support/process.h"
 
+namespace test_script_safety {
+
 namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace tippe;
@@ -167,3 +169,5 @@ TEST(ScriptSafety, SweepRecordsWithAHostileNameAreRefused) {
     spit(out / "records.jsonl", text);
   }
 }
+
+}  // namespace test_script_safety

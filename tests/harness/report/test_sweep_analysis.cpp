@@ -10,6 +10,8 @@
 #include "harness/report/sweep_analysis.h"
 #include "tests/support/sweep_points.h"
 
+namespace test_sweep_analysis {
+
 using namespace tippe;
 
 namespace {
@@ -318,3 +320,5 @@ TEST(SweepAnalysis, ThePageNamesTheEnergyItsGainRuleCounted) {
   }
   EXPECT_NE(render_sweep_markdown(rs).find("(energy_gain_rule = stored)"), std::string::npos) << render_sweep_markdown(rs);
 }
+
+}  // namespace test_sweep_analysis

@@ -14,7 +14,7 @@
 #include "tests/support/fixtures.h"
 #include "tests/support/process.h"
 
-namespace tippe {
+namespace tippe::test_resolve {
 namespace {
 
 using fixtures::edit;

@@ -19,6 +19,8 @@
 #include "tests/support/process.h"
 #include "tests/support/sweep_runs.h"
 
+namespace test_mpi_farm {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -223,3 +225,5 @@ TEST(SweepMpi, ABuildWithoutMpiRefusesToRunAsOneOfManyRanks) {
 #endif
 
 }  // namespace
+
+}  // namespace test_mpi_farm

@@ -13,6 +13,8 @@
 #include "tests/support/fixtures.h"
 #include "tests/support/sweep_files.h"
 
+namespace test_sweep_file {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 
@@ -258,3 +260,5 @@ TEST(SweepLadders, BadCategoricalValuesAreRefusedAtLoad) {
     EXPECT_EQ(msg.rfind(p.string() + cases[i].expected, 0), 0u) << "case " << i << ": " << msg;
   }
 }
+
+}  // namespace test_sweep_file

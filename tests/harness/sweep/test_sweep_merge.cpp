@@ -16,6 +16,8 @@
 #include "tests/support/process.h"
 #include "tests/support/sweep_runs.h"
 
+namespace test_sweep_merge {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -243,3 +245,5 @@ TEST(SweepShards, GridAndCategoricalLaddersShardMergeAndResumeAsOneRun) {
 }
 
 }  // namespace
+
+}  // namespace test_sweep_merge

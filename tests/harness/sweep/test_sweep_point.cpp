@@ -14,6 +14,8 @@
 #include "tests/support/records.h"
 #include "tests/support/sweep_files.h"
 
+namespace test_sweep_point {
+
 using namespace tippe;
 using namespace tippe::sweep_detail;
 
@@ -147,3 +149,5 @@ TEST(SweepRepeats, ThreeRepeatsGiveOneRunsRecordWithThreeTimes) {
     EXPECT_EQ(j, by_ladder.at(r.ladder_index));
   }
 }
+
+}  // namespace test_sweep_point

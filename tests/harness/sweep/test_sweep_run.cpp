@@ -19,6 +19,8 @@
 #include "tests/support/records.h"
 #include "tests/support/sweep_files.h"
 
+namespace test_sweep_run {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -207,3 +209,5 @@ TEST(SweepCli, InvalidSweepExitsWithTwoAndWritesNothing) {
   EXPECT_EQ(e.code, 2);
   EXPECT_FALSE(fs::exists(out));
 }
+
+}  // namespace test_sweep_run

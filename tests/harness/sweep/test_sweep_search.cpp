@@ -21,6 +21,8 @@
 #include "tests/support/fixtures.h"
 #include "tests/support/sweep_searches.h"
 
+namespace test_sweep_search {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -343,3 +345,5 @@ TEST(SweepSearchInput, SetupScenesNameScenesOfTheSweep) {
 }
 
 }  // namespace
+
+}  // namespace test_sweep_search

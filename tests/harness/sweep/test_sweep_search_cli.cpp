@@ -17,6 +17,8 @@
 #include "harness/report/sweep_analysis.h"
 #include "tests/support/fixtures.h"
 
+namespace test_sweep_search_cli {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using nlohmann::json;
@@ -191,3 +193,5 @@ TEST(SweepSearchDistributed, ShardsMergedAndMpiRanksGiveTheRecordsOfOneRun) {
 }
 
 }  // namespace
+
+}  // namespace test_sweep_search_cli

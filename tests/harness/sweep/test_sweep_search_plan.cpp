@@ -16,6 +16,8 @@
 #include "tests/support/records.h"
 #include "tests/support/sweep_searches.h"
 
+namespace test_sweep_search_plan {
+
 using namespace tippe;
 using nlohmann::json;
 
@@ -170,3 +172,5 @@ TEST(SweepSearchPlan, PointIdsHashTheSearch) {
 }
 
 }  // namespace
+
+}  // namespace test_sweep_search_plan

@@ -14,6 +14,8 @@
 #include "tests/support/records.h"
 #include "tests/support/sweep_runs.h"
 
+namespace test_sweep_self_check {
+
 namespace fs = std::filesystem;
 using namespace tippe;
 using namespace tippe::fixtures;
@@ -237,3 +239,5 @@ TEST(SweepSelfCheck, UnderMpiACachedReferenceWithoutItHasTheCheckAloneRunAndShar
 #endif
 
 }  // namespace
+
+}  // namespace test_sweep_self_check
