@@ -437,7 +437,7 @@ PYBIND11_MODULE(_tippe, m) {
       [](const std::string& scene, const std::string& out, const std::vector<std::string>& engines,
          const std::string& criterion, double tolerance, long long max_runs, int jobs, double from, double to,
          double resolution, std::optional<double> duration, const std::vector<std::string>& axis, bool restart,
-         bool plots, bool progress) {
+         bool plots, bool progress, int repeats) {
         tippe::AdviseOptions o;
         o.scene = scene;
         o.out = out;
@@ -454,6 +454,7 @@ PYBIND11_MODULE(_tippe, m) {
         o.restart = restart;
         o.plots = plots;
         o.progress = progress;
+        o.repeats = repeats;
         tippe::AdviceResult r;
         const QuietUnless quiet(progress);
         Runner runner{py::none()};

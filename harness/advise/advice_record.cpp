@@ -13,6 +13,7 @@ AdviceRecord advice_record(const AdviceResult& result) {
   a.reference_inversion_time = result.reference_inversion;
   a.duration = result.duration;
   a.runs = static_cast<long long>(result.runs);
+  a.repeats = result.repeats;
   a.gate_written = result.gate_written;
   for (const AdviceEngine& e : result.engines) {
     EngineAdvice x;

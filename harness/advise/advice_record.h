@@ -22,7 +22,7 @@ struct EngineAdvice {
   std::vector<std::string> settings;      // engines.E.KEY=VALUE, the cost knob's advised value last
   std::optional<double> advised_step;     // the largest safe step / kAdviceMargin, confirmed by a run
   std::optional<double> largest_safe_step, first_unsafe_step;
-  std::optional<double> cpu_seconds;      // of the confirming run
+  std::optional<double> cpu_seconds;      // of the confirming point: the least of its runs
   std::string confirm_point;              // its point id in confirm/records.jsonl
   std::vector<std::string> near_ties;     // configurations not told apart from it by CPU time
   std::string reason;                     // why there is no advice
@@ -46,7 +46,8 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, EngineAdvice>> visit(R& 
   v(Field("first_unsafe_step", "the smallest unsafe value above it; null: safe to the end of the searched range")
         .minimum(0),
     a.first_unsafe_step);
-  v(Field("cpu_seconds", "s: CPU of the confirming run").minimum(0), a.cpu_seconds);
+  v(Field("cpu_seconds", "s: CPU of the confirming point, the least of its runs (the record's repeats)").minimum(0),
+    a.cpu_seconds);
   v(Field("confirm_point", "the confirming run's point id (confirm/records.jsonl); null: none").empty_as_null(),
     a.confirm_point);
   v(Field("near_ties",
@@ -68,6 +69,7 @@ struct AdviceRecord {
   std::optional<double> reference_inversion_time;
   double duration = 0;
   long long runs = 0;
+  long long repeats = 1;
   bool gate_written = false;
   std::vector<EngineAdvice> engines;
 };
@@ -79,6 +81,11 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, AdviceRecord>> visit(R& 
   v(Field("reference_inversion_time", "s; null: no inversion").minimum(0), a.reference_inversion_time);
   v(Field("duration", "s: the horizon of every run").minimum(0), a.duration);
   v(Field("runs", "search and confirming runs").minimum(0), a.runs);
+  v(Field("repeats", "runs of each confirming point, interleaved; its CPU time is their least (advice written "
+                     "before the field: 1)")
+        .since()
+        .minimum(1),
+    a.repeats);
   v(Field("gate_written", "advice.toml was written (some engine has advice)"), a.gate_written);
   v(Field("engines", "one per engine, in the order asked"), a.engines);
 }

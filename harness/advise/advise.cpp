@@ -77,10 +77,11 @@ std::vector<std::string> split_commas(const std::string& s) {
 std::string knob_key(const std::string& engine, const std::string& knob) { return "engines." + engine + "." + knob; }
 
 // The sweep file text of the searches (one setup per configuration) or of the confirming runs.
+// `repeats`: the runs of each point (the confirming runs' cost; a search's points run once).
 std::string sweep_text(const std::string& description, const std::string& scene_rel, std::optional<double> duration,
-                       const std::vector<std::pair<AdviceConfig, std::string>>& setups) {
+                       const std::vector<std::pair<AdviceConfig, std::string>>& setups, int repeats = 1) {
   std::string t = "# Written by `tippe advise` (" + description + "); resumable: `tippe sweep` runs it too.\n";
-  t += "description = " + toml_string(description) + "\nrepeats = 1\n";
+  t += "description = " + toml_string(description) + "\nrepeats = " + std::to_string(repeats) + "\n";
   t += "scenes = [ { file = " + toml_string(scene_rel) +
        (duration ? ", duration = " + search_value_text(*duration) : std::string()) + " } ]\n";
   for (const auto& [c, ladder] : setups) {
@@ -105,7 +106,7 @@ std::string search_ladder(const std::string& key, const AdviseOptions& o, const 
 // Runs a sweep file into a directory with the sweep machinery (resumable, --jobs), then reads
 // its records back.
 std::vector<SweepRecord> run_sweep_file(const std::string& file, const std::string& dir, const AdviseOptions& o,
-                                        size_t& runs, bool report) {
+                                        size_t& runs, bool report, int repeats = 1) {
   SweepOptions so;
   so.out_dir = dir;
   so.jobs = o.jobs;
@@ -115,7 +116,7 @@ std::vector<SweepRecord> run_sweep_file(const std::string& file, const std::stri
   if (report)
     so.write_report = [plots](const std::string& d, const std::vector<SweepRecord>& r) { write_sweep_report(d, r, plots); };
   const SweepOutcome out = run_search_sweep(load_sweep(file), so);
-  runs += out.points;
+  runs += out.points * static_cast<size_t>(repeats);
   return read_records((fs::path(dir) / "records.jsonl").string()).records;
 }
 
@@ -284,7 +285,10 @@ AdviceResult run_advise(const AdviseOptions& o) {
   if (o.out.empty()) throw std::invalid_argument("--out DIR is required");
   if (!(o.from > 0 && o.to > o.from)) throw std::invalid_argument("the range needs 0 < --from < --to");
   if (o.max_runs < 1) throw std::invalid_argument("--max-runs must be at least 1");
+  if (o.repeats < 1 || o.repeats > kMaxRepeats)
+    throw std::invalid_argument("--repeats must be from 1 to " + std::to_string(kMaxRepeats));
   AdviceResult res;
+  res.repeats = o.repeats;
   std::vector<std::string> over;
   if (o.duration) over.push_back("run.duration=" + search_value_text(*o.duration));
   const Scene scene = load_scene(o.scene, over);  // its own errors name the file and key
@@ -346,8 +350,9 @@ AdviceResult run_advise(const AdviseOptions& o) {
   if (!confirm_setups.empty()) {
     write_file_atomic((out / "confirm-sweep.toml").string(),
                       sweep_text("confirming runs of " + what + " at the boundary / " + sig3(kAdviceMargin), scene_rel,
-                                 o.duration, confirm_setups));
-    confirm = run_sweep_file((out / "confirm-sweep.toml").string(), (out / "confirm").string(), o, res.runs, false);
+                                 o.duration, confirm_setups, o.repeats));
+    confirm = run_sweep_file((out / "confirm-sweep.toml").string(), (out / "confirm").string(), o, res.runs, false,
+                             o.repeats);
   }
   for (AdviceEngine& e : res.engines) choose_advice(e, criterion, confirm);
 
@@ -409,8 +414,9 @@ AdviceResult run_advise(const AdviseOptions& o) {
       const AdviceConfig& c = e.configs[*e.chosen];
       t += c.text() + ", " + e.knob + " " + search_value_text(e.step) + " keeps the top " +
            (res.reference_inverts ? "inverting like the reference" : "in the reference's regime (no inversion)") +
-           " to t = " + sig3(res.duration) + " (" + res.criterion + "); " + sig3(e.cpu_seconds) +
-           " CPU s; the largest safe " + e.knob + " is " + search_value_text(e.boundary) +
+           " to t = " + sig3(res.duration) + " (" + res.criterion + "); " + sig3(e.cpu_seconds) + " CPU s" +
+           (res.repeats > 1 ? " (the least of " + std::to_string(res.repeats) + " runs)" : std::string()) +
+           "; the largest safe " + e.knob + " is " + search_value_text(e.boundary) +
            (e.beyond > 0 ? " (unsafe at " + search_value_text(e.beyond) + ")" : " (safe to the end of the range)");
       if (!e.sensitivity.empty()) t += "; " + join(e.sensitivity, ", ");
       const std::vector<std::string> ties = advice_ties_text(e);
@@ -429,12 +435,17 @@ AdviceResult run_advise(const AdviseOptions& o) {
            energy_counted_text(rule) + " (energy_gain_rule = " + to_string(rule) +
            "), no Jellett drift where J is conserved), and " +
            res.criterion + ". The advised " + "step is the largest safe step found / " + sig3(kAdviceMargin) +
-           ", confirmed by a run there. " +
+           ", confirmed by a run there" +
+           (res.repeats > 1 ? "; a configuration's CPU time is the least of its confirming point's " +
+                                  std::to_string(res.repeats) + " runs, interleaved with the other configurations' (--repeats)"
+                            : std::string()) +
+           ". " +
            (res.gate_written ? "advice.toml is the gate that keeps it: `tippe gate advice.toml`."
                              : "No engine has advice: no gate is written."));
   doc.heading(2, "Configurations");
   DocTable t;
-  t.header = {"engine", "configuration", "search", "largest safe step", "first unsafe", "runs", "advised", "CPU s"};
+  t.header = {"engine", "configuration", "search", "largest safe step", "first unsafe", "runs", "advised",
+              res.repeats > 1 ? "CPU s (least of " + std::to_string(res.repeats) + ")" : std::string("CPU s")};
   for (const AdviceEngine& e : res.engines) {
     for (size_t i = 0; i < e.configs.size(); ++i) {
       const SearchBoundary& b = e.boundaries[i];

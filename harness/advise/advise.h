@@ -22,6 +22,10 @@ struct AdviseOptions {
   std::string criterion;             // empty: "regime and inversion within TOLERANCE"
   double tolerance = 0.01;           // of the inversion time, where the reference inverts
   long long max_runs = 400;          // the budget of search runs over all engines
+  // Runs of each configuration's confirming point, interleaved with the other configurations'
+  // (the sweep's `repeats`): its CPU time, which chooses the cheapest, is the least of them. One
+  // run took 0.232-0.387 CPU s on the shared two-core machine (BENCHMARKS.md, "A point's repeats").
+  int repeats = 3;
   int jobs = 1;
   std::string out;
   double from = 1e-5, to = 1e-1;  // the cost knob's range
@@ -72,6 +76,7 @@ struct AdviceResult {
   double duration = 0;
   std::vector<AdviceEngine> engines;
   size_t runs = 0;      // search and confirming points
+  int repeats = 1;      // runs of each confirming point (AdviseOptions::repeats)
   bool gate_written = false;
 };
 

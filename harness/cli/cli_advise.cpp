@@ -76,6 +76,10 @@ Command setup_advise(CLI::App& app) {
   sub->add_option("--max-runs", o->max_runs, "Budget of search runs over all engines (default 400)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--jobs,-j", o->jobs, "Runs in parallel (default 1)")->check(CLI::PositiveNumber);
+  sub->add_option("--repeats", o->repeats,
+                  "Runs of each configuration's confirming point, interleaved; its CPU time, which chooses the "
+                  "cheapest, is their least (default 3)")
+      ->check(CLI::Range(1, kMaxRepeats));
   sub->add_option("--from", o->from, "Smallest time step searched (default 1e-5)");
   sub->add_option("--to", o->to, "Largest time step searched (default 0.1)");
   sub->add_option("--resolution", o->resolution, "Search resolution in log10 units (default 0.05)");

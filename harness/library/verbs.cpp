@@ -224,6 +224,7 @@ nlohmann::json to_json(const AdviceResult& r) {
   j["reference_inversion"] = optional_number(r.reference_inversion);
   j["duration"] = r.duration;
   j["runs"] = r.runs;
+  j["repeats"] = r.repeats;
   j["gate_written"] = r.gate_written;
   nlohmann::json engines = nlohmann::json::array();
   for (const AdviceEngine& e : r.engines) {

@@ -200,9 +200,11 @@ def sweep(file: Union[str, os.PathLike, dict], out: str | None = None, *, jobs: 
 def advise(scene: SceneLike, out: str | None = None, *, engines: Iterable[str] = (), criterion: str = "",
            tolerance: float = 0.01, max_runs: int = 400, jobs: int = 1, step_from: float = 1e-5,
            step_to: float = 0.1, resolution: float = 0.05, duration: float | None = None,
-           axis: Iterable[str] = (), restart: bool = False, plots: bool = False, progress: bool = True) -> Advice:
+           axis: Iterable[str] = (), restart: bool = False, plots: bool = False, progress: bool = True,
+           repeats: int = 3) -> Advice:
     """Each engine's cheapest safe settings for a scene (`tippe advise`), searched into ``out``
-    (default out/NAME-advice; rerun to resume): the advice; out/advice.toml is its gate."""
+    (default out/NAME-advice; rerun to resume): the advice; out/advice.toml is its gate.
+    ``repeats``: runs of each configuration's confirming point (its CPU time is their least)."""
     with tempfile.TemporaryDirectory() as tmp:
         if isinstance(scene, (str, os.PathLike)) and not isinstance(scene, Scene):
             path = os.fspath(scene)
@@ -221,7 +223,7 @@ def advise(scene: SceneLike, out: str | None = None, *, engines: Iterable[str] =
         text = _tippe.advise(path, out, list(engines), criterion, float(tolerance), int(max_runs), int(jobs),
                              float(step_from), float(step_to), float(resolution),
                              None if duration is None else float(duration), list(axis), bool(restart), bool(plots),
-                             bool(progress))
+                             bool(progress), int(repeats))
     a = Advice.from_json(text)
     object.__setattr__(a, "out", out)
     return a

@@ -74,6 +74,14 @@ TEST(Advise, FindsTheBoundaryInLogRunsAndWritesAGateThatHolds) {
   const SearchCriterion c = parse_criterion("regime and inversion within 10%");
   EXPECT_TRUE(is_safe(c, confirm[0])) << unsafe_reason(c, confirm[0]);
   EXPECT_EQ(confirm[0].ladder_value, search_round(*b[0].boundary / kAdviceMargin));
+  // Its cost, which chooses among configurations, is the least of its three runs (the default
+  // --repeats), not one run's: the searches' points run once.
+  EXPECT_EQ(confirm[0].repeats, 3);
+  ASSERT_EQ(confirm[0].cpu_seconds_repeats.size(), 3u);
+  EXPECT_EQ(confirm[0].cpu_seconds,
+            *std::min_element(confirm[0].cpu_seconds_repeats.begin(), confirm[0].cpu_seconds_repeats.end()));
+  for (const SweepRecord& r : records) EXPECT_EQ(r.repeats, 1) << r.point_id;
+  EXPECT_NE(md.find(" CPU s (the least of 3 runs)"), std::string::npos) << md;
 
   // The record says what the page and the gate say.
   const json advice = json::parse(slurp(out / "advice.json"));
@@ -85,6 +93,10 @@ TEST(Advise, FindsTheBoundaryInLogRunsAndWritesAGateThatHolds) {
   EXPECT_EQ(ode.at("largest_safe_step").get<double>(), *b[0].boundary);
   EXPECT_EQ(ode.at("settings").back(), "engines.ode.timestep=" + search_value_text(confirm[0].ladder_value));
   EXPECT_EQ(ode.at("confirm_point"), confirm[0].point_id);
+  EXPECT_EQ(ode.at("cpu_seconds").get<double>(), confirm[0].cpu_seconds);
+  EXPECT_EQ(advice.at("repeats"), 3);
+  // 4 coarse values and the bisection (the points above), each once, and the confirming point 3 times.
+  EXPECT_EQ(advice.at("runs").get<size_t>(), records.size() + 3);
   EXPECT_TRUE(ode.at("reason").is_null());
   EXPECT_TRUE(advice.at("gate_written").get<bool>());
 
@@ -117,6 +129,21 @@ TEST(Advise, NothingSafeInRangeSaysSoAndPinsNoGate) {
   EXPECT_NE(text.find("gate: none"), std::string::npos) << text;
   EXPECT_FALSE(fs::exists(out / "advice.toml"));
   EXPECT_NE(slurp(out / "index.md").find("no advice"), std::string::npos);
+}
+
+// --repeats outside 1..kMaxRepeats is a usage error before anything runs or is written.
+TEST(Advise, RepeatsOutOfRangeIsAnErrorAndWritesNothing) {
+  TempDir dir;
+  const fs::path log = dir.path() / "out.txt", err = dir.path() / "err.txt";
+  for (const std::string bad : {"0", "101", "x"}) {
+    const fs::path out = dir.path() / ("advice-" + bad);
+    std::vector<std::string> argv = advise_ode(out, "1e-4", "1e-1");
+    argv.insert(argv.begin() + 2, {"--repeats", bad});
+    const ChildExit e = run(argv, log, err);
+    EXPECT_EQ(e.code, 2) << bad << ": " << slurp(err);
+    EXPECT_NE(slurp(err).find("--repeats"), std::string::npos) << slurp(err);
+    EXPECT_FALSE(fs::exists(out)) << bad;
+  }
 }
 
 TEST(Advise, ConfigurationsComeFromTheRegistry) {
