@@ -10,7 +10,8 @@ command -v "$cxx" >/dev/null || { echo "sanitize: $cxx not found" >&2; exit 2; }
 # clang: its -fsanitize=undefined also checks float->int conversions that overflow, which g++'s
 # does not. -O1 with line tables only (all a stack trace needs) keeps the build and the run
 # affordable; asserts stay on (no NDEBUG) so Eigen's and the project's own checks run too.
-# TIPPE_FUZZ=ON adds libFuzzer's coverage instrumentation (the sanitizer runtime serves it), so
+# TIPPE_FUZZ=ON adds libFuzzer's coverage instrumentation to the parsers' libraries (the sanitizer
+# runtime serves it; CMakeLists.txt, TIPPE_FUZZ_COVERAGE), so
 # that scripts/fuzz.sh reuses this very build instead of compiling everything a second time.
 # TIPPE_MPI=OFF: LeakSanitizer reports Open MPI 4.1's own allocations (a bare MPI_Init/MPI_Finalize
 # program: 121 KB in 3351 allocations), which would fail every MPI run here;
