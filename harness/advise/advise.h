@@ -75,7 +75,7 @@ struct AdviceResult {
   std::optional<double> reference_inversion;
   double duration = 0;
   std::vector<AdviceEngine> engines;
-  size_t runs = 0;      // search and confirming points
+  size_t runs = 0;      // search and confirming runs (each repeat of a confirming point counts)
   int repeats = 1;      // runs of each confirming point (AdviseOptions::repeats)
   bool gate_written = false;
 };
