@@ -104,9 +104,9 @@ std::string search_ladder(const std::string& key, const AdviseOptions& o, const 
 }
 
 // Runs a sweep file into a directory with the sweep machinery (resumable, --jobs), then reads
-// its records back.
+// its records back; `runs` grows by its points times the file's repeats.
 std::vector<SweepRecord> run_sweep_file(const std::string& file, const std::string& dir, const AdviseOptions& o,
-                                        size_t& runs, bool report, int repeats = 1) {
+                                        size_t& runs, bool report) {
   SweepOptions so;
   so.out_dir = dir;
   so.jobs = o.jobs;
@@ -115,8 +115,9 @@ std::vector<SweepRecord> run_sweep_file(const std::string& file, const std::stri
   const bool plots = o.plots;
   if (report)
     so.write_report = [plots](const std::string& d, const std::vector<SweepRecord>& r) { write_sweep_report(d, r, plots); };
-  const SweepOutcome out = run_search_sweep(load_sweep(file), so);
-  runs += out.points * static_cast<size_t>(repeats);
+  const SweepPlan plan = load_sweep(file);
+  const SweepOutcome out = run_search_sweep(plan, so);
+  runs += out.points * static_cast<size_t>(plan.spec.repeats);
   return read_records((fs::path(dir) / "records.jsonl").string()).records;
 }
 
@@ -351,8 +352,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
     write_file_atomic((out / "confirm-sweep.toml").string(),
                       sweep_text("confirming runs of " + what + " at the boundary / " + sig3(kAdviceMargin), scene_rel,
                                  o.duration, confirm_setups, o.repeats));
-    confirm = run_sweep_file((out / "confirm-sweep.toml").string(), (out / "confirm").string(), o, res.runs, false,
-                             o.repeats);
+    confirm = run_sweep_file((out / "confirm-sweep.toml").string(), (out / "confirm").string(), o, res.runs, false);
   }
   for (AdviceEngine& e : res.engines) choose_advice(e, criterion, confirm);
 
