@@ -24,6 +24,7 @@
 #include <toml++/toml.h>
 
 #include "harness/advise/advise.h"
+#include "harness/advise/advice_record.h"
 #include "harness/io/output_dir.h"
 #include "harness/io/progress.h"
 #include "harness/io/scene_io.h"
@@ -467,9 +468,9 @@ PYBIND11_MODULE(_tippe, m) {
             throw tippe::InputError(e.what());
           }
         });
-        return dump(tippe::to_json(r));
+        return tippe::advice_json_text(tippe::advice_record(r));
       },
-      "Each engine's cheapest safe settings for a scene file (`tippe advise`): the advice as JSON text.");
+      "Each engine's cheapest safe settings for a scene file (`tippe advise`): advice.json's text.");
 
   m.def(
       "gate",

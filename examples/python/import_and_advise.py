@@ -19,5 +19,5 @@ advice = tippe.advise(scene, out="out/my_top-advice", engines=["ode"], max_runs=
                       step_from=1e-3, resolution=0.3)
 print(advice)  # the lines `tippe advise` prints
 for e in advice.engines:
-    if e.advised:
-        print(f"{e.engine}: set {', '.join(e.config.set)} and {e.knob} = {e.step}")
+    if e.advised_step is not None:
+        print(f"{e.engine}: set {', '.join(e.settings)}")  # the cost knob's advised value last

@@ -36,6 +36,21 @@ AdviceRecord advice_record(const AdviceResult& result) {
     } else {
       x.reason = e.reason;
     }
+    for (size_t i = 0; i < e.configs.size(); ++i) {
+      const AdviceConfig& c = e.configs[i];
+      SearchedConfiguration sc;
+      sc.configuration = c.text();
+      sc.settings = c.set();
+      if (i < e.boundaries.size()) {
+        const SearchBoundary& b = e.boundaries[i];
+        sc.status = b.status;
+        sc.largest_safe_step = b.boundary;
+        sc.first_unsafe_step = b.beyond;
+        sc.runs = static_cast<long long>(b.runs);
+      }
+      x.searched.push_back(std::move(sc));
+    }
+    for (const AdviceConfig& c : e.unsearched) x.not_searched.push_back(c.text());
     a.engines.push_back(std::move(x));
   }
   return a;
@@ -46,6 +61,8 @@ nlohmann::json to_json(const AdviceRecord& record) {
   j["format"] = kAdviceFormat;
   return j;
 }
+
+std::string advice_json_text(const AdviceRecord& record) { return to_json(record).dump(2) + "\n"; }
 
 std::string advice_schema_text() {
   nlohmann::ordered_json s = {

@@ -15,6 +15,32 @@ namespace tippe {
 
 inline constexpr const char* kAdviceFormat = "tippe-advice-1";
 
+// One configuration an engine's search covered, and what its boundary search found: why it
+// was or was not advised (the page's table of searched configurations).
+struct SearchedConfiguration {
+  std::string configuration;              // "integrator = RK4, cone = elliptic"; "its defaults": no axes
+  std::vector<std::string> settings;      // engines.E.KEY=VALUE, one per axis
+  std::string status;                     // the search's (SearchBoundary::status); empty: no records yet
+  std::optional<double> largest_safe_step, first_unsafe_step;
+  long long runs = 0;
+};
+template <class R, class V>
+std::enable_if_t<std::is_same_v<std::remove_const_t<R>, SearchedConfiguration>> visit(R& a, V& v) {
+  v(Field("configuration", "the values of the engine's categorical axes (\"its defaults\": it declares none)"),
+    a.configuration);
+  v(Field("settings", "the configuration as --set arguments"), a.settings);
+  v(Field("status",
+          "the boundary search's outcome: found, all_safe, none_safe, incomplete or not_applicable; null: no "
+          "records")
+        .empty_as_null(),
+    a.status);
+  v(Field("largest_safe_step", "the largest safe value of the cost knob found; null: none").minimum(0),
+    a.largest_safe_step);
+  v(Field("first_unsafe_step", "the smallest unsafe value above it; null: none in the searched range").minimum(0),
+    a.first_unsafe_step);
+  v(Field("runs", "runs of this search").minimum(0), a.runs);
+}
+
 // One engine's advice, flat: what the page's sentence and the gate say of it.
 struct EngineAdvice {
   std::string engine, knob;
@@ -28,6 +54,8 @@ struct EngineAdvice {
   std::string reason;                     // why there is no advice
   long long configurations_searched = 0, configurations_not_searched = 0;
   std::vector<std::string> sensitivity;   // one sentence per axis
+  std::vector<SearchedConfiguration> searched;  // in search order
+  std::vector<std::string> not_searched;        // configurations left out by the budget
 };
 template <class R, class V>
 std::enable_if_t<std::is_same_v<std::remove_const_t<R>, EngineAdvice>> visit(R& a, V& v) {
@@ -60,6 +88,14 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, EngineAdvice>> visit(R& 
   v(Field("configurations_not_searched", "configurations left out by the run budget (--max-runs)").minimum(0),
     a.configurations_not_searched);
   v(Field("sensitivity", "per categorical axis, how far it moved the boundary"), a.sensitivity);
+  v(Field("searched", "every configuration searched, in order, with its boundary (advice written before the "
+                      "field: absent)")
+        .since(),
+    a.searched);
+  v(Field("not_searched", "the configurations left out by the run budget (advice written before the field: "
+                          "absent)")
+        .since(),
+    a.not_searched);
 }
 
 // The whole advice: the scene, the one criterion of "safe", the reference's answer, each engine's.
@@ -94,6 +130,8 @@ std::enable_if_t<std::is_same_v<std::remove_const_t<R>, AdviceRecord>> visit(R& 
 AdviceRecord advice_record(const AdviceResult& result);
 // {"format": kAdviceFormat, ...the record's fields}.
 nlohmann::json to_json(const AdviceRecord& record);
+// OUT/advice.json's text (what the Python verb returns too).
+std::string advice_json_text(const AdviceRecord& record);
 // schemas/advice.schema.json: the frame and the fields of the two lists.
 std::string advice_schema_text();
 

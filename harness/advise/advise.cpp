@@ -402,7 +402,7 @@ AdviceResult run_advise(const AdviseOptions& o) {
   }
 
   // The record: what the page says, for a program (its fields: advice_record.h).
-  write_file_atomic((out / "advice.json").string(), to_json(advice_record(res)).dump(2) + "\n");
+  write_file_atomic((out / "advice.json").string(), advice_json_text(advice_record(res)));
 
   // The page: one sentence per engine, the configurations, the evidence.
   Document doc;

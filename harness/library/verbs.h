@@ -14,7 +14,6 @@
 #include <nlohmann/json.hpp>
 #include "include/tippe/tippe.h"
 
-#include "harness/advise/advise.h"
 #include "harness/gating/gate.h"
 #include "harness/gating/gate_boundary.h"
 #include "harness/library/columns.h"
@@ -76,8 +75,5 @@ std::vector<CheckResult> run_gate(const GatePlan& plan, const GateRequest& reque
 // The registry as JSON: per simulator its name, role, version, colour, settings (key, type,
 // default, allowed and, for numbers, bounds), advice axes and cost knob (`tippe info`'s facts).
 nlohmann::json engines_to_json();
-
-// `tippe advise`'s result as JSON (what its lines print, and each engine's searched boundaries).
-nlohmann::json to_json(const AdviceResult& r);
 
 }  // namespace tippe

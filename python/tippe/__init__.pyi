@@ -97,10 +97,17 @@ class SweepResult:
     def to_pandas(self) -> Any: ...
     def plot(self, metric: str = ..., ax: Any = ...) -> Any: ...
 
-class Advice(Record):
+class Advice(Record):  # advice.json's record (schemas/advice.schema.json)
     out: str
-    engines: list[Record]
+    scene: str
+    criterion: str
+    reference_inverts: bool
+    reference_inversion_time: float | None
+    duration: float
     runs: int
+    repeats: int
+    gate_written: bool
+    engines: list[Record]  # EngineAdvice: engine, configuration, settings, advised_step, ..., searched
 
 class GateResult(Record):
     passed: bool

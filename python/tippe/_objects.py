@@ -258,14 +258,15 @@ class SweepResult:
 
 
 class Advice(Record):
-    """`tippe advise`'s result: per engine the advised configuration and step, or why none."""
+    """`tippe advise`'s result, advice.json's record (schemas/advice.schema.json): per engine the
+    advised configuration and step, or why none, and every configuration searched."""
 
     def __str__(self) -> str:
         lines = []
         for e in self._data["engines"]:
-            if e["advised"]:
-                lines.append(f"{e['engine']}: {e['config']['text']}, {e['knob']} {e['step']:g} "
-                             f"(largest safe {e['boundary']:g}; {e['cpu_seconds']:.3g} CPU s)")
+            if e["advised_step"] is not None:
+                lines.append(f"{e['engine']}: {e['configuration']}, {e['knob']} {e['advised_step']:g} "
+                             f"(largest safe {e['largest_safe_step']:g}; {e['cpu_seconds']:.3g} CPU s)")
             else:
                 lines.append(f"{e['engine']}: no advice: {e['reason']}")
         return "\n".join(lines)

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ostream>
 #include <random>
 #include <string>
 #include <utility>
@@ -84,6 +85,10 @@ const DetectorBounds kBounds[] = {
     {"fcl", 1e-12, 1.2e-12},
     {"bullet", 1.6e-2, 1.2e-2},
 };
+
+// GoogleTest prints a parameter into the test's listed name (and CTest's): its detector's name,
+// not the struct's bytes, which hold a pointer and differ between builds.
+void PrintTo(const DetectorBounds& row, std::ostream* os) { *os << row.detector; }
 
 class DartDetector : public ::testing::TestWithParam<DetectorBounds> {};
 

@@ -273,6 +273,8 @@ def test_import_advise(exe, src, tmp):
     a = tippe.advise(str(tmp / "py.toml"), out=str(tmp / "adv-py"), engines=["ode"], max_runs=12, duration=0.3,
                      step_from=1e-3, resolution=0.3, progress=False)
     check("advice fields", a.engines[0].engine == "ode" and a.runs == int(re.search(r"runs: (\d+)", printed)[1]))
+    check("the advice is advice.json's record", a.json == (tmp / "adv-py/advice.json").read_text()
+          and len(a.engines[0].searched) == a.engines[0].configurations_searched)
     # The advice is the cheapest configuration by CPU time, and which one that is (and which others
     # are within 10 % of it) can differ between two runs of the search when costs are near: the
     # verb and the command are compared on the same records, a copy of the command's directory,

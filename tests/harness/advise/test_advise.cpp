@@ -99,6 +99,14 @@ TEST(Advise, FindsTheBoundaryInLogRunsAndWritesAGateThatHolds) {
   EXPECT_EQ(advice.at("runs").get<size_t>(), records.size() + 3);
   EXPECT_TRUE(ode.at("reason").is_null());
   EXPECT_TRUE(advice.at("gate_written").get<bool>());
+  // Every configuration searched, with what its search found (the page's table).
+  ASSERT_EQ(ode.at("searched").size(), 1u);
+  const json& searched = ode.at("searched").at(0);
+  EXPECT_EQ(searched.at("status"), "found");
+  EXPECT_EQ(searched.at("largest_safe_step").get<double>(), *b[0].boundary);
+  EXPECT_EQ(searched.at("first_unsafe_step").get<double>(), *b[0].beyond);
+  EXPECT_EQ(searched.at("runs").get<size_t>(), records.size());
+  EXPECT_EQ(ode.at("not_searched"), json::array());
 
   // The gate passes as written ...
   const fs::path gate = out / "advice.toml";
@@ -317,6 +325,13 @@ TEST(AdviceRecord, WritesExactlyItsListedFields) {
   chosen.beyond = 0;  // safe to the end of the range
   chosen.cpu_seconds = 0.5;
   chosen.confirm_point = "p1";
+  chosen.configs.push_back({"mujoco", "mujoco-1", {"integrator"}, {"\"Euler\""}});
+  chosen.unsearched.push_back({"mujoco", "mujoco-2", {"integrator"}, {"\"implicit\""}});
+  SearchBoundary found;
+  found.status = "found";
+  found.boundary = 4e-4;
+  found.runs = 9;
+  chosen.boundaries = {found};  // the second configuration's search has no records yet
   AdviceEngine none;
   none.engine = "ode";
   none.knob = "timestep";
@@ -332,6 +347,10 @@ TEST(AdviceRecord, WritesExactlyItsListedFields) {
   for (const auto& [k, v] : j.at("engines").at(0).items()) engine_keys.insert(k);
   for (const FieldInfo& f : field_list<EngineAdvice>()) engine_listed.insert(f.key);
   EXPECT_EQ(engine_keys, engine_listed);
+  std::set<std::string> searched_keys, searched_listed;
+  for (const auto& [k, v] : j.at("engines").at(0).at("searched").at(0).items()) searched_keys.insert(k);
+  for (const FieldInfo& f : field_list<SearchedConfiguration>()) searched_listed.insert(f.key);
+  EXPECT_EQ(searched_keys, searched_listed);
 
   const json& m = j.at("engines").at(0);
   EXPECT_EQ(m.at("configuration"), "integrator = RK4");
@@ -339,6 +358,18 @@ TEST(AdviceRecord, WritesExactlyItsListedFields) {
   EXPECT_EQ(m.at("advised_step"), 2e-4);
   EXPECT_TRUE(m.at("first_unsafe_step").is_null());
   EXPECT_TRUE(m.at("reason").is_null());
+  // Each searched configuration with its search's outcome (none yet for the second), then the
+  // ones the budget left out.
+  ASSERT_EQ(m.at("searched").size(), 2u);
+  EXPECT_EQ(m.at("searched").at(0).at("configuration"), "integrator = RK4");
+  EXPECT_EQ(m.at("searched").at(0).at("status"), "found");
+  EXPECT_EQ(m.at("searched").at(0).at("largest_safe_step"), 4e-4);
+  EXPECT_TRUE(m.at("searched").at(0).at("first_unsafe_step").is_null());
+  EXPECT_EQ(m.at("searched").at(0).at("runs"), 9);
+  EXPECT_EQ(m.at("searched").at(1).at("settings"), json({"engines.mujoco.integrator=\"Euler\""}));
+  EXPECT_TRUE(m.at("searched").at(1).at("status").is_null());
+  EXPECT_TRUE(m.at("searched").at(1).at("largest_safe_step").is_null());
+  EXPECT_EQ(m.at("not_searched"), json({"integrator = implicit"}));
   const json& o = j.at("engines").at(1);
   EXPECT_TRUE(o.at("configuration").is_null());
   EXPECT_TRUE(o.at("advised_step").is_null());
