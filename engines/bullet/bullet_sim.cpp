@@ -75,6 +75,8 @@ void BulletSimulator::engine_step() {
   r.p_WC_stem = sum.surfaces.p_WC_stem;
   r.weight_ball = sum.surfaces.weight_ball;
   r.weight_stem = sum.surfaces.weight_stem;
+  r.points_ball = sum.surfaces.points_ball;
+  r.points_stem = sum.surfaces.points_stem;
   finish_surface_points(r);
   report_ = r;
   // The torsional row's bound is min(mu_d P_n, mu_d) (btSequentialImpulseConstraintSolver caps

@@ -59,6 +59,10 @@ struct SurfaceContactForce {
   Vec3 f_t_W = Vec3::Zero();  // tangential (friction) force, lab frame
   bool point_valid = false;   // p_WC is known (F_n > 0)
   Vec3 p_WC = Vec3::Zero();   // point of application, lab frame
+  // The contact points the engine reported on this surface in the step (summed over its internal
+  // steps where it takes several), with or without force: a sphere on a plane touches at one, and
+  // more is the engine's own (a cached manifold, a box face's corners), never the bench's.
+  int points = 0;
 };
 
 // The forces at the top's two contact surfaces. Where the bench applies the friction law itself

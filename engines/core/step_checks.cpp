@@ -39,6 +39,7 @@ Observation observe_with_contacts(const BodyModel& body, const BodyState& x, con
 
 void add_surface_force(ContactReport& r, bool stem, double f_n, const Vec3& f_t_W, const Vec3& p_W) {
   (stem ? r.friction_stem_W : r.friction_ball_W) += f_t_W;
+  ++(stem ? r.points_stem : r.points_ball);
   if (f_n > 0) {
     (stem ? r.p_WC_stem : r.p_WC_ball) += f_n * p_W;
     (stem ? r.weight_stem : r.weight_ball) += f_n;
@@ -79,8 +80,8 @@ void finish_stage_forces(StepMeanForces& mean) {
 
 EngineContactForces contact_forces(const ContactReport& r) {
   EngineContactForces f;
-  f.ball = {r.ball, r.normal_force_ball, r.friction_ball_W, r.weight_ball > 0, r.p_WC_ball};
-  f.stem = {r.stem, r.normal_force_stem, r.friction_stem_W, r.weight_stem > 0, r.p_WC_stem};
+  f.ball = {r.ball, r.normal_force_ball, r.friction_ball_W, r.weight_ball > 0, r.p_WC_ball, r.points_ball};
+  f.stem = {r.stem, r.normal_force_stem, r.friction_stem_W, r.weight_stem > 0, r.p_WC_stem, r.points_stem};
   return f;
 }
 

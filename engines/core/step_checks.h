@@ -64,6 +64,7 @@ struct ContactReport {
   Vec3 friction_ball_W = Vec3::Zero(), friction_stem_W = Vec3::Zero();
   Vec3 p_WC_ball = Vec3::Zero(), p_WC_stem = Vec3::Zero();
   double weight_ball = 0.0, weight_stem = 0.0;  // the positive F_n summed into each point
+  int points_ball = 0, points_stem = 0;         // the engine's points on each (add_surface_force calls)
   BenchWrench bench;         // the part of the friction the bench applied (add_bench_friction)
   StepMeanForces step_mean;  // set by an adapter whose step's forces are not the report's
   StepWork step_work;        // set by an adapter whose integrator gives the step's work

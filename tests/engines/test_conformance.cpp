@@ -237,13 +237,7 @@ TEST_P(Conformance, TorqueFreePrecession) {
 
 TEST_P(Conformance, SlidingBallStartsRolling) {
   // A uniform ball launched sliding at v0 rolls from t = 2 v0 / (7 mu g) at speed 5 v0 / 7.
-  Scene s = fixtures::dimensionless_scene();
-  s.contact.stem = false;
-  s.mass = {1.0, 0.0, 0.4, 0.4};
-  s.initial.tilt = 0.0;
-  s.initial.spin = 0.0;
-  s.initial.velocity_given = true;
-  s.initial.velocity = {1.0, 0.0};
+  Scene s = fixtures::sliding_ball(1.0);
   const double v0 = 1.0, mu = s.contact.mu, g = s.gravity;
   const double t_roll = 2 * v0 / (7 * mu * g);
   auto sim = make(s);

@@ -81,11 +81,7 @@ struct SlideSamples {
 };
 
 SlideSamples sample_slide(const std::string& engine) {
-  Scene s = base_scene();
-  s.contact.stem = false;
-  s.mass = {1.0, 0.0, 0.4, 0.4};
-  s.initial.velocity_given = true;
-  s.initial.velocity = {1.0, 0.0};
+  const Scene s = fixtures::sliding_ball(1.0);
   const double mu = s.contact.mu;
   auto sim = make_simulator(engine, s);
   SlideSamples out;
@@ -228,6 +224,42 @@ TEST_P(ContactForcesTest, ViscousFrictionWorkIsTheWorkTheBenchApplied) {
               row().engine, engine, applied, rel, row().viscous_work);
   EXPECT_LT(applied, 0.0) << "viscous friction removes energy";
   EXPECT_LE(rel, row().viscous_work) << row().why;
+}
+
+// A uniform ball (the stem left out) launched sliding at v0 = 1 and spinning about the vertical at
+// 30 rad/s (R = 1, g = 1): a sphere on a plane touches at one point, so each step's report holds
+// one engine point on the ball, whatever the engine's contact model (a persistent manifold that
+// kept an earlier step's points, or a box floor's detector reporting several, would show here).
+// Read at every step of the engine (its own fixed step; 1e-4 s for Simbody), 300 steps.
+struct PointCounts {
+  int steps = 0, with_contact = 0, fewest = 1 << 30, most = 0;
+};
+
+PointCounts count_points(const std::string& engine, const Scene& s) {
+  auto sim = make_simulator(engine, s);
+  const double h = sampling_step(*sim);
+  PointCounts c;
+  for (int k = 1; k <= 300; ++k) {
+    sim->advance_to(k * h);
+    const EngineContactForces f = sim->contact_forces();
+    ++c.steps;
+    if (f.stem.points > 0) ADD_FAILURE() << engine << ": a stem point on a ball without a stem";
+    if (!f.ball.active) continue;
+    ++c.with_contact;
+    c.fewest = std::min(c.fewest, f.ball.points);
+    c.most = std::max(c.most, f.ball.points);
+  }
+  EXPECT_EQ(sim->status(), RunStatus::Ok) << engine << ": " << sim->status_detail();
+  return c;
+}
+
+TEST_P(ContactForcesTest, ASpinningSlidingBallTouchesAtOnePointEachStep) {
+  const PointCounts c = count_points(row().engine, fixtures::sliding_ball(1.0, 30.0));
+  std::printf("[%s] spinning, sliding ball: a ball contact at %d of %d steps, %d to %d points each\n", row().engine,
+              c.with_contact, c.steps, c.with_contact ? c.fewest : 0, c.most);
+  ASSERT_GT(c.with_contact, 0) << row().engine << ": no contact";
+  EXPECT_EQ(c.fewest, 1) << row().engine;
+  EXPECT_EQ(c.most, 1) << row().engine;
 }
 
 INSTANTIATE_TEST_SUITE_P(Engines, ContactForcesTest, ::testing::ValuesIn(kRows),

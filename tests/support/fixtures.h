@@ -50,6 +50,19 @@ inline Scene dimensionless_scene(FrictionLaw law = FrictionLaw::Coulomb, double 
   return s;
 }
 
+// A uniform ball on the dimensionless scene's floor (the stem left out, I = 2/5 M R^2, G at the
+// ball's centre), upright, launched sliding along x at v0 and spinning about the vertical at `spin`.
+inline Scene sliding_ball(double v0 = 1.0, double spin = 0.0) {
+  Scene s = dimensionless_scene();
+  s.contact.stem = false;
+  s.mass = {1.0, 0.0, 0.4, 0.4};
+  s.initial.tilt = 0.0;
+  s.initial.spin = spin;
+  s.initial.velocity_given = true;
+  s.initial.velocity = {v0, 0.0};
+  return s;
+}
+
 // The same top as a scene file (given mass properties, so nothing depends on the
 // mass-properties code): a valid file the input tests edit one key at a time.
 inline const char* const kBase = R"(name = "base"

@@ -43,15 +43,9 @@ TEST(Simbody, GlidingLawIsSimbodysViscousFriction) {
   // (static and dynamic 0), its own contact force gives that law. 2e-3 relative: the Hertz
   // ringing of the normal force (damped here by c = 500) and the creep of the friction's
   // regularization (none: uv has no transition).
-  Scene s = fixtures::dimensionless_scene();
+  Scene s = fixtures::sliding_ball(1.0);
   s.contact.friction = FrictionLaw::Gliding;
   s.contact.mu = 1.0;
-  s.contact.stem = false;
-  s.mass = {1.0, 0.0, 0.4, 0.4};
-  s.initial.tilt = 0.0;
-  s.initial.spin = 0.0;
-  s.initial.velocity_given = true;
-  s.initial.velocity = {1.0, 0.0};
   s.engines["simbody"]["dissipation"] = 500.0;
   auto sim = make_simulator("simbody", s);
   const double t = 0.4;
