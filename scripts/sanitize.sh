@@ -35,21 +35,15 @@ export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:detect_stack_use_after_retur
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:log_path=$logs/report"
 export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
 # The long system runs of tests/sanitizer/long-runs.txt are left out by name (each with its
-# reason there); a line that is not a plain test name stops the script.
-skip=()
-while IFS= read -r line; do
-  case "$line" in ''|'#'*) continue ;; esac
-  if ! [[ "$line" =~ ^[A-Za-z0-9_./]+$ ]]; then
-    echo "sanitize: $supp/long-runs.txt: '$line' is not a test name (letters, digits, _ . / only)" >&2
-    exit 2
-  fi
-  skip+=("$line")  # its dots match themselves among other characters: the names are anchored whole
-done <"$supp/long-runs.txt"
-# A parameterized test's CTest name goes on after its GoogleTest name ("NAME  # GetParam() = ..."):
-# the name is matched whole, then either the end or that space.
-exclude="^($(IFS='|'; echo "${skip[*]}"))( .*)?\$"
+# reason there; a line that is not a plain test name stops the script), and the `slow` label.
+# Each GoogleTest program runs in shards of up to 32 tests, a process each, rather than a process
+# per test as CTest starts them: under ASan a process costs 0.2-0.35 s to start and end whatever
+# its test does, and the suite is mostly short tests (BENCHMARKS.md, "The test programs and CI").
+# The other tests (scripts, the library's consumer) run through CTest.
 rc=0
-(cd "$build" && ctest -LE slow -E "$exclude" --output-on-failure -j"${JOBS:-$(nproc)}" --timeout 900) || rc=$?
+python3 "$root/scripts/sanitize-tests.py" "$build" --exclude-label slow --exclude-file "$supp/long-runs.txt" \
+  --jobs "${JOBS:-$(nproc)}" --timeout 900 || rc=$?
+[ "$rc" -eq 2 ] && exit 2
 t2=$(date +%s)
 echo "sanitize: tests $(( t2 - t1 )) s"
 
