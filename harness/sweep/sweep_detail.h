@@ -1,13 +1,15 @@
-// What the parts of a sweep run share: each scene's reference, one point's run, and a point's a-priori cost.
+// What the parts of a sweep run share: each scene's reference, the coordinator's decision of what runs, one point's run, and a point's a-priori cost.
 #pragma once
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "harness/io/output_dir.h"
 #include "harness/measure/compare.h"
 #include "harness/sweep/sweep.h"
 
@@ -107,5 +109,24 @@ struct SweepTask {
 std::vector<SweepTask> repeat_schedule(size_t points, int repeats, size_t block);
 // A priori cost of a point in arbitrary units (steps for a time-step ladder).
 double point_weight(const SweepPlan& plan, const SweepPoint& p);
+
+// What the coordinator found in OUT and decided, shared with every rank: which points run, in
+// which order, and which references must be computed.
+struct Prepared {
+  std::vector<size_t> todo;        // indices into plan.points, in the order they are handed out
+  std::vector<size_t> needed;      // scenes with a point in todo
+  std::vector<size_t> to_compute;  // of those, the ones not in the cache
+  std::vector<size_t> to_check;    // of those, the ones in the cache without the self-check asked for
+  size_t share = 0, skipped = 0, cached = 0, partial_bytes = 0;
+};
+
+// The coordinator's half of a sweep's start (sweep_prepare.cpp): checks OUT, takes its lock,
+// recovers records.jsonl, decides what runs and loads the cached references into `refs`. Throws
+// SweepInputError before anything is written.
+Prepared prepare(const SweepPlan& plan, const SweepOptions& o, std::unique_ptr<OutputDir>& lock,
+                 std::vector<Reference>& refs);
+// The decision as the message every rank reads.
+std::string encode(const Prepared& p);
+Prepared decode(const std::string& bytes);
 
 }  // namespace tippe::sweep_detail
