@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """Runs a sanitizer build's CTest suite with a process per shard of a test program instead of a process per test.
 
-Under ASan a test program's process costs 0.2-0.35 s to start and to end (its 38 MB of globals
-poisoned, LeakSanitizer's scan at exit) whatever the test does; the sanitized suite's 810
+Under ASan a test program's process costs 0.2-0.35 s to start and to end whatever the test does
+(a 38 MB program; 0.22-0.27 s with no test run, 0.36-0.38 s with LeakSanitizer's scan at exit,
+BENCHMARKS.md, "The test programs and CI"); the sanitized suite's 810
 GoogleTest tests paid that 810 times (about a third of its CPU). Here each program runs its tests
 in a few shards, each one process (`--gtest_filter` naming its tests exactly), the shards on
-`--jobs` workers, longest programs first; the tests that are not GoogleTest's (scripts, the
+`--jobs` workers, in rounds across the programs; the tests that are not GoogleTest's (scripts, the
 library's consumer) run through CTest as before. What runs is what CTest would run: its test list
 (`ctest --show-only=json-v1`) with the label and names left out, disabled tests skipped.
 
