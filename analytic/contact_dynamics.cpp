@@ -8,6 +8,7 @@
 // vanishes: n . (a_G + dw/dt x R_C + w x (w x r_GO)) = 0, with r_GO the vector from G to the
 // centre of the contacting sphere (the lowest point moves over the sphere, the centre does not).
 #include "analytic/contact_dynamics.h"
+#include "analytic/detail/contact_kinematics.h"
 #include "analytic/detail/contact_unknowns.h"
 
 #include <Eigen/Dense>
@@ -19,7 +20,13 @@ namespace tippe {
 
 namespace {
 
+using contact_detail::gravity_force;
+using contact_detail::gyroscopic_torque;
+using contact_detail::kinematics;
+using contact_detail::Kinematics;
 using contact_detail::kMaxUnknowns;
+using contact_detail::sliding_drill_coeff;
+using contact_detail::write_derivative;
 using contact_detail::MatN;
 using contact_detail::VecN;
 
@@ -84,6 +91,17 @@ double ContactDynamics::gap_acceleration(const StateVector& y, const StateVector
 }
 
 ContactForces ContactDynamics::evaluate(const StateVector& y, const ContactMode& mode, StateVector* dydt) const {
+  // The common mode of a viscous run in closed form (contact_viscous_one.cpp), bit for bit what
+  // the general solve gives it.
+  if (c_.friction == FrictionLaw::Viscous && mode.slot[0].active != mode.slot[1].active) {
+    const int s = mode.slot[0].active ? 0 : 1;
+    const ContactSlot& slot = mode.slot[s];
+    if (!slot.graze && !slot.stick && !slot.drill_stick) return evaluate_viscous_one(y, s, slot, dydt);
+  }
+  return evaluate_general(y, mode, dydt);
+}
+
+ContactForces ContactDynamics::evaluate_general(const StateVector& y, const ContactMode& mode, StateVector* dydt) const {
   int grazing = -1, n_grazing = 0;
   for (int s = 0; s < 2; ++s)
     if (mode.slot[s].active && mode.slot[s].graze) {
@@ -236,19 +254,15 @@ ContactForces ContactDynamics::evaluate_slip_start(const StateVector& y, const C
 
 ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const ContactMode& mode, StateVector* dydt,
                                               double share) const {
-  const BodyState x = unpack(y, 0.0);
-  const double qn2 = x.q_WB.squaredNorm();
-  const Quat q = x.q_WB.normalized();
-  const Eigen::Matrix3d R_WB = q.toRotationMatrix();
-  const Vec3 w_W = R_WB * x.w_B;
-  const Vec3 I_B(m_.A, m_.A, m_.C);
-  // I_W w_W = R (I_B w_B): the world inertia itself is not needed, only its inverse.
-  const Eigen::Matrix3d Iinv_W = R_WB * I_B.cwiseInverse().asDiagonal() * R_WB.transpose();
+  const Kinematics k = kinematics(y, m_);
+  const BodyState& x = k.x;
+  const Eigen::Matrix3d& R_WB = k.R_WB;
+  const Vec3& w_W = k.w_W;
+  const Eigen::Matrix3d& Iinv_W = k.Iinv_W;
   const Vec3 e_z = Vec3::UnitZ();
 
   ContactForces out;
-  Vec3 F_known = -m_.M * m_.g * e_z;
-  Vec3 T_known = -w_W.cross(R_WB * I_B.cwiseProduct(x.w_B));
+  Vec3 F_known = gravity_force(m_), T_known = gyroscopic_torque(k);
   Column cols[kMaxUnknowns];
   Row rows[kMaxUnknowns];
   int n = 0;
@@ -334,11 +348,7 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
       F_known += -c_.k * slip;
       T_known += r.cross(-c_.k * slip);
     }
-    if (c_.drilling > 0.0 && !slot.drill_stick && !coupled_sliding) {
-      const double spin_z = w_W.z();
-      const double sign = slot.drill_dir != 0.0 ? slot.drill_dir : (spin_z > 0 ? 1.0 : (spin_z < 0 ? -1.0 : 0.0));
-      drill_coeff = -c_.drilling * sign;
-    }
+    if (c_.drilling > 0.0 && !slot.drill_stick && !coupled_sliding) drill_coeff = sliding_drill_coeff(c_.drilling, slot, w_W);
     idx[s].normal = n;
     idx[s].normal_dir = fdir;
     idx[s].drill_coeff = drill_coeff;
@@ -419,24 +429,7 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
     out.drill_torque[s] = idx[s].drill >= 0 ? u(idx[s].drill) : idx[s].drill_coeff * fn;
   }
 
-  if (dydt) {
-    const Vec3 a_G = F / m_.M;
-    const Vec3 wdot_B = I_B.cwiseInverse().cwiseProduct(R_WB.transpose() * T);
-    // Quaternion rate from body-frame omega, plus a term that pulls |q| back to 1 at the rate
-    // of the motion: the unit sphere is invariant, so the exact solution is unchanged.
-    const double kappa = std::max(1.0, x.w_B.norm());
-    const double qw = y[6], qx = y[7], qy = y[8], qz = y[9];
-    const double wx = x.w_B.x(), wy = x.w_B.y(), wz = x.w_B.z();
-    const double pull = kappa * (1.0 - qn2);
-    StateVector& d = *dydt;
-    d[0] = x.v_WG.x(); d[1] = x.v_WG.y(); d[2] = x.v_WG.z();
-    d[3] = a_G.x(); d[4] = a_G.y(); d[5] = a_G.z();
-    d[6] = 0.5 * (-qx * wx - qy * wy - qz * wz) + pull * qw;
-    d[7] = 0.5 * (qw * wx + qy * wz - qz * wy) + pull * qx;
-    d[8] = 0.5 * (qw * wy + qz * wx - qx * wz) + pull * qy;
-    d[9] = 0.5 * (qw * wz + qx * wy - qy * wx) + pull * qz;
-    d[10] = wdot_B.x(); d[11] = wdot_B.y(); d[12] = wdot_B.z();
-  }
+  if (dydt) write_derivative(k, y, m_, F, T, *dydt);
   return out;
 }
 

@@ -95,6 +95,10 @@ class ContactDynamics {
   ContactGeometry geometry(const BodyState& x, int slot) const;
   // Derivative of the state and the contact forces for a mode. dydt may be null.
   ContactForces evaluate(const StateVector& y, const ContactMode& mode, StateVector* dydt) const;
+  // evaluate() by the general solve whatever the mode. evaluate() takes a closed form for one
+  // sliding contact under the viscous law (a viscous run's common mode), which must give bit
+  // for bit what this gives (tests/analytic/test_contact_dynamics.cpp).
+  ContactForces evaluate_general(const StateVector& y, const ContactMode& mode, StateVector* dydt) const;
   // Velocity of the material point at the lowest point of a surface (lab frame).
   Vec3 contact_velocity(const BodyState& x, int slot) const;
 
@@ -160,6 +164,8 @@ class ContactDynamics {
   Vec3 slip_rate(const StateVector& y, const StateVector& dy, int s) const;
   // evaluate() with every grazing contact carrying the fixed share `share` of its viscous force.
   ContactForces evaluate_fixed(const StateVector& y, const ContactMode& mode, StateVector* dydt, double share) const;
+  // evaluate() for one active contact `s` under the viscous law, neither sticking nor grazing.
+  ContactForces evaluate_viscous_one(const StateVector& y, int s, const ContactSlot& slot, StateVector* dydt) const;
   BodyModel m_;
   ContactSpec c_;
 };
