@@ -9,9 +9,12 @@
 #include <utility>
 #include <vector>
 
-#include "harness/io/output_dir.h"
 #include "harness/measure/compare.h"
 #include "harness/sweep/sweep.h"
+
+namespace tippe {
+class OutputDir;  // harness/io/output_dir.h: prepare() holds the sweep directory's lock
+}  // namespace tippe
 
 namespace tippe::sweep_detail {
 

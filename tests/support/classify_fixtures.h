@@ -8,6 +8,7 @@
 #include "analytic/scene.h"
 #include "harness/measure/classify.h"
 #include "harness/records/records.h"
+#include "tests/support/run_records.h"
 
 namespace tippe {
 
@@ -23,12 +24,7 @@ inline Scene viscous_scene() {
   return s;
 }
 
-inline RunRecord ok_run() {
-  RunRecord r;
-  r.engine = "fake";
-  r.status = "ok";
-  return r;
-}
+inline RunRecord ok_run() { return fixtures::ok_record("fake"); }
 
 inline void expect_ok(const RunClass& c) {
   EXPECT_EQ(c.kind, RunClassKind::Ok) << c.reason;

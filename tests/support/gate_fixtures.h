@@ -7,6 +7,7 @@
 
 #include "harness/gating/gate.h"
 #include "tests/support/files.h"
+#include "tests/support/run_records.h"
 
 namespace tippe::fixtures {
 
@@ -24,9 +25,7 @@ inline Check fixture_check() {
 }
 
 inline RunRecord fixture_record(const std::string& engine, std::optional<double> inversion) {
-  RunRecord r;
-  r.engine = engine;
-  r.status = "ok";
+  RunRecord r = ok_record(engine);
   r.inversion_time = inversion;
   r.work.wall_seconds = 0.25;
   return r;
