@@ -26,6 +26,8 @@ using contact_detail::kinematics;
 using contact_detail::Kinematics;
 using contact_detail::kMaxUnknowns;
 using contact_detail::sliding_drill_coeff;
+using contact_detail::slot_kinematics;
+using contact_detail::SlotKinematics;
 using contact_detail::write_derivative;
 using contact_detail::MatN;
 using contact_detail::VecN;
@@ -255,8 +257,6 @@ ContactForces ContactDynamics::evaluate_slip_start(const StateVector& y, const C
 ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const ContactMode& mode, StateVector* dydt,
                                               double share) const {
   const Kinematics k = kinematics(y, m_);
-  const BodyState& x = k.x;
-  const Eigen::Matrix3d& R_WB = k.R_WB;
   const Vec3& w_W = k.w_W;
   const Eigen::Matrix3d& Iinv_W = k.Iinv_W;
   const Vec3 e_z = Vec3::UnitZ();
@@ -276,16 +276,11 @@ ContactForces ContactDynamics::evaluate_fixed(const StateVector& y, const Contac
   for (int s = 0; s < 2; ++s) {
     const ContactSlot& slot = mode.slot[s];
     if (!slot.active) continue;
-    // geometry(x, s) from the rotation already at hand (it would normalize q again).
-    ContactGeometry g;
-    g.radius = s == 0 ? m_.R : m_.r;
-    g.r_GO_W = (s == 0 ? m_.z_O() : m_.z_P()) * Vec3(R_WB.col(2));
-    g.r_GC_W = g.r_GO_W - g.radius * Vec3::UnitZ();
-    const Vec3& r = g.r_GC_W;
-    Vec3 slip = x.v_WG + w_W.cross(r);
-    slip.z() = 0.0;
+    const SlotKinematics sk = slot_kinematics(k, m_, s);
+    const Vec3& r = sk.g.r_GC_W;
+    const Vec3& slip = sk.slip_W;
     out.slip_W[s] = slip;
-    const Vec3 centripetal = w_W.cross(w_W.cross(g.r_GO_W));
+    const Vec3& centripetal = sk.centripetal_W;
     auto add_row = [&](const Vec3& dir) {
       rows[n - 1] = {dir, r.cross(dir), dir.dot(centripetal)};
     };

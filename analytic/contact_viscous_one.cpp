@@ -15,6 +15,8 @@ using contact_detail::gyroscopic_torque;
 using contact_detail::kinematics;
 using contact_detail::Kinematics;
 using contact_detail::sliding_drill_coeff;
+using contact_detail::slot_kinematics;
+using contact_detail::SlotKinematics;
 using contact_detail::write_derivative;
 
 ContactForces ContactDynamics::evaluate_viscous_one(const StateVector& y, int s, const ContactSlot& slot,
@@ -25,13 +27,11 @@ ContactForces ContactDynamics::evaluate_viscous_one(const StateVector& y, int s,
 
   ContactForces out;
   Vec3 F_known = gravity_force(m_), T_known = gyroscopic_torque(k);
-  const double radius = s == 0 ? m_.R : m_.r;
-  const Vec3 r_GO = (s == 0 ? m_.z_O() : m_.z_P()) * Vec3(k.R_WB.col(2));
-  const Vec3 r = r_GO - radius * Vec3::UnitZ();  // r_GC_W
-  Vec3 slip = k.x.v_WG + w_W.cross(r);
-  slip.z() = 0.0;
+  const SlotKinematics sk = slot_kinematics(k, m_, s);
+  const Vec3& r = sk.g.r_GC_W;
+  const Vec3& slip = sk.slip_W;
   out.slip_W[s] = slip;
-  const Vec3 centripetal = w_W.cross(w_W.cross(r_GO));
+  const Vec3& centripetal = sk.centripetal_W;
   F_known += -c_.k * slip;
   T_known += r.cross(-c_.k * slip);
   const double drill_coeff = c_.drilling > 0.0 ? sliding_drill_coeff(c_.drilling, slot, w_W) : 0.0;

@@ -61,7 +61,7 @@ def first_difference(a_path, b_path):
     return min(len(la), len(lb)) + 1
 
 
-def compare(before, after, name):
+def compare(before, after):
     """What differs between the runs in directories before and after, as a list of phrases."""
     found = []
     for f in ("trajectory.csv", "summary.json"):
@@ -109,33 +109,33 @@ def main():
         return 2
 
     work = a.keep or tempfile.mkdtemp(prefix="same-results-")
-    jobs = []
-    for scene in scenes:
+    pairs = [(scene, engine) for scene in scenes for engine in engines]
+
+    def out_dir(side, scene, engine):
         name = os.path.splitext(scene)[0].replace("harness/scenes/", "").replace("/", "_")
-        for engine in engines:
-            for side, tippe in (("before", a.before), ("after", a.after)):
-                jobs.append((side, tippe, scene, engine, os.path.join(work, side, name + "-" + engine)))
+        return os.path.join(work, side, name + "-" + engine)
+
+    runs = [(side, tippe, scene, engine) for scene, engine in pairs
+            for side, tippe in (("before", a.before), ("after", a.after))]
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as pool:
-        results = dict(zip([(j[0], j[2], j[3]) for j in jobs],
-                           pool.map(lambda j: run(j[1], os.path.join(ROOT, j[2]), j[3], a.sets, j[4]), jobs)))
+        outcomes = pool.map(lambda r: run(r[1], os.path.join(ROOT, r[2]), r[3], a.sets, out_dir(r[0], r[2], r[3])), runs)
+        results = {(r[0], r[2], r[3]): o for r, o in zip(runs, outcomes)}
 
     differ = 0
-    for scene in scenes:
-        name = os.path.splitext(scene)[0].replace("harness/scenes/", "").replace("/", "_")
-        for engine in engines:
-            (rc_b, err_b), (rc_a, err_a) = results[("before", scene, engine)], results[("after", scene, engine)]
-            dirs = [os.path.join(work, side, name + "-" + engine) for side in ("before", "after")]
-            if rc_b != 0 or rc_a != 0:
-                last = lambda text: text.splitlines()[-1] if text else ""
-                found = [] if (rc_b, err_b) == (rc_a, err_a) else [
-                    "exit %d against %d (%s | %s)" % (rc_b, rc_a, last(err_b), last(err_a))]
-                label = "both refuse (exit %d)" % rc_b if not found else ""
-            else:
-                found, label = compare(dirs[0], dirs[1], name), ""
-            differ += bool(found)
-            print("%-5s %s %s%s" % ("DIFF" if found else "same", scene, engine,
-                                    ": " + "; ".join(found) if found else (": " + label if label else "")))
-    print("same-results: %d of %d runs differ%s" % (differ, len(scenes) * len(engines),
+    last = lambda text: text.splitlines()[-1] if text else ""
+    for scene, engine in pairs:
+        (rc_b, err_b), (rc_a, err_a) = results[("before", scene, engine)], results[("after", scene, engine)]
+        label = ""
+        if rc_b != 0 or rc_a != 0:
+            found = [] if (rc_b, err_b) == (rc_a, err_a) else [
+                "exit %d against %d (%s | %s)" % (rc_b, rc_a, last(err_b), last(err_a))]
+            label = "both refuse (exit %d)" % rc_b if not found else ""
+        else:
+            found = compare(out_dir("before", scene, engine), out_dir("after", scene, engine))
+        differ += bool(found)
+        print("%-5s %s %s%s" % ("DIFF" if found else "same", scene, engine,
+                                ": " + "; ".join(found) if found else (": " + label if label else "")))
+    print("same-results: %d of %d runs differ%s" % (differ, len(pairs),
                                                      " (runs kept in %s)" % work if a.keep else ""))
     if not a.keep:
         shutil.rmtree(work, ignore_errors=True)

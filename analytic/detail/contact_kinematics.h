@@ -41,6 +41,26 @@ TIPPE_INLINE_KINEMATICS Kinematics kinematics(const StateVector& y, const BodyMo
   return Kinematics{x, qn2, R_WB, w_W, I_B, Iinv_W};
 }
 
+// What a contact slot's constraint needs of the kinematics: its geometry (ContactDynamics::geometry
+// from the rotation at hand, which would otherwise normalise q again), the horizontal velocity of
+// the material point at C and the centripetal term w x (w x r_GO) of its sphere's centre.
+struct SlotKinematics {
+  ContactGeometry g;
+  Vec3 slip_W;
+  Vec3 centripetal_W;
+};
+
+inline SlotKinematics slot_kinematics(const Kinematics& k, const BodyModel& m, int s) {
+  ContactGeometry g;
+  g.radius = s == 0 ? m.R : m.r;
+  g.r_GO_W = (s == 0 ? m.z_O() : m.z_P()) * Vec3(k.R_WB.col(2));
+  g.r_GC_W = g.r_GO_W - g.radius * Vec3::UnitZ();
+  Vec3 slip = k.x.v_WG + k.w_W.cross(g.r_GC_W);
+  slip.z() = 0.0;
+  const Vec3 centripetal = k.w_W.cross(k.w_W.cross(g.r_GO_W));
+  return SlotKinematics{g, slip, centripetal};
+}
+
 inline Vec3 gravity_force(const BodyModel& m) { return -m.M * m.g * Vec3::UnitZ(); }
 
 // -w x (I w) in the lab frame: the torque-free body's own rate of change of I_W w_W.
